@@ -1,1 +1,11 @@
-//! mergesim
+//! mergesim: cooperative autonomous vehicles merging on a highway.
+//!
+//! The workspace's crates, re-exported for the `merge_sim` binary, the integration tests and
+//! the benchmarks: [`planner`] (pure potential-field planning with interactive speed
+//! optimisation), [`vehicles`] (Rapier vehicles and tracker), [`sim`] (the closed loop) and
+//! [`scenarios`] (scenario files).
+
+pub mod output;
+pub mod summary;
+
+pub use {planner, scenarios, sim, vehicles};

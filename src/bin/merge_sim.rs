@@ -1,1 +1,441 @@
-fn main() {}
+//! `merge_sim`: run, compare and inspect cooperative merge simulations.
+//!
+//! Exit codes: 0 success, 1 the simulation or an output failed, 2 bad input (arguments,
+//! scenario values, presets) — reported with the offending value, before anything is written.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, anyhow};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use mergesim::output::{check_output_path, write_atomically};
+use mergesim::summary::RunSummary;
+use planner::PlannerKind;
+use scenarios::Scenario;
+use sim::recording::Recorder;
+use sim::{RunOptions, RunOutcome, TimeSeriesRow, World};
+use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
+
+/// Cooperative merge simulator: potential-field planners with interactive speed optimisation
+/// (Lin et al.) on physics-based Rapier vehicles.
+///
+/// With no subcommand, `merge_sim` runs the paper's urgent merge with PF-ISO, prints a summary
+/// table and writes a Rerun recording (urgent_merge_pf-iso.rrd) in the current folder.
+#[derive(Parser, Debug)]
+#[command(name = "merge_sim", version, args_conflicts_with_subcommands = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run one scenario closed-loop (the default).
+    Run(RunArgs),
+    /// Run every planner on one scenario and print them side by side.
+    Compare(CompareArgs),
+    /// Open-loop vehicle-dynamics tests on a flat pad (no planner).
+    Maneuver(ManeuverArgs),
+    /// List or print the built-in scenarios.
+    #[command(subcommand)]
+    Scenario(ScenarioCommand),
+}
+
+#[derive(Args, Debug, Clone)]
+struct RunArgs {
+    /// Built-in scenario name or path to a scenario TOML file.
+    #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
+    scenario: String,
+    /// Planner of every planner-driven vehicle (overrides the scenario's choice).
+    #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
+    planner: Option<PlannerKind>,
+    /// Seed of the run's random streams (V2V drops). Without it the nominal scenario runs.
+    #[arg(long, value_name = "N")]
+    seed: Option<u64>,
+    /// Where to write the Rerun recording [default: <scenario>_<planner>.rrd].
+    #[arg(long, value_name = "PATH", conflicts_with = "no_rrd")]
+    rrd: Option<PathBuf>,
+    /// Do not write a Rerun recording.
+    #[arg(long)]
+    no_rrd: bool,
+    /// Open the recording in the Rerun viewer afterwards (needs `rerun` on PATH).
+    #[arg(long, conflicts_with = "no_rrd")]
+    view: bool,
+    /// Write the JSON summary here.
+    #[arg(long, value_name = "PATH")]
+    json: Option<PathBuf>,
+    /// Write the time series (one row per vehicle per logged instant) here.
+    #[arg(long, value_name = "PATH")]
+    csv: Option<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(Args, Debug)]
+struct CompareArgs {
+    /// Built-in scenario name or path to a scenario TOML file.
+    #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
+    scenario: String,
+    /// Planners to compare, comma-separated.
+    #[arg(long, value_delimiter = ',', value_parser = parse_planner,
+          default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
+    planners: Vec<PlannerKind>,
+    /// Seed of the runs' random streams.
+    #[arg(long, value_name = "N")]
+    seed: Option<u64>,
+    /// Write the JSON summaries (an array) here.
+    #[arg(long, value_name = "PATH")]
+    json: Option<PathBuf>,
+}
+
+#[derive(Copy, Clone, Debug, ValueEnum)]
+enum ManeuverName {
+    /// Hold --speed-mps with the speed PID at fixed --steer-rad; report the settled state.
+    SteadyState,
+    /// Step the steering to --steer-rad at --speed-mps; report the response.
+    StepSteer,
+    /// Full braking from --speed-mps to standstill; report the stopping distance.
+    Braking,
+}
+
+#[derive(Args, Debug)]
+struct ManeuverArgs {
+    /// Which test.
+    maneuver: ManeuverName,
+    /// Vehicle preset: bmw_320i, ford_escort, vw_vanagon.
+    #[arg(long, default_value = "bmw_320i")]
+    vehicle: String,
+    /// Tire–road friction coefficient μ (> 0).
+    #[arg(long, default_value_t = 0.8)]
+    mu: f64,
+    /// Speed (m/s).
+    #[arg(long, default_value_t = 20.0)]
+    speed_mps: f64,
+    /// Front wheel steering angle (rad).
+    #[arg(long, default_value_t = 0.02, allow_negative_numbers = true)]
+    steer_rad: f64,
+    /// Physics step (s).
+    #[arg(long, default_value_t = 0.002)]
+    dt_s: f64,
+    /// Write the report as JSON here.
+    #[arg(long, value_name = "PATH")]
+    json: Option<PathBuf>,
+}
+
+#[derive(Subcommand, Debug)]
+enum ScenarioCommand {
+    /// List the built-in scenarios.
+    List,
+    /// Print a built-in scenario as TOML (which `--scenario PATH` reads back unchanged).
+    Show {
+        /// Built-in name.
+        name: String,
+    },
+}
+
+fn parse_planner(text: &str) -> Result<PlannerKind, String> {
+    text.parse::<PlannerKind>().map_err(|e| e.to_string())
+}
+
+/// An error with its exit code: 2 for bad input, 1 for failures while running.
+enum Failure {
+    Input(anyhow::Error),
+    Run(anyhow::Error),
+}
+
+fn input<E: Into<anyhow::Error>>(e: E) -> Failure {
+    Failure::Input(e.into())
+}
+
+fn run_failure<E: Into<anyhow::Error>>(e: E) -> Failure {
+    Failure::Run(e.into())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => cmd_run(&cli.run),
+        Some(Command::Run(args)) => cmd_run(&args),
+        Some(Command::Compare(args)) => cmd_compare(&args),
+        Some(Command::Maneuver(args)) => cmd_maneuver(&args),
+        Some(Command::Scenario(cmd)) => cmd_scenario(&cmd),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Input(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Run(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// The planner name of a run: the override, or the scenario's single kind, or `mixed`.
+fn planner_label(scenario: &Scenario, planner: Option<PlannerKind>) -> String {
+    if let Some(kind) = planner {
+        return kind.name().to_string();
+    }
+    let mut kinds: Vec<&str> = scenario
+        .vehicles
+        .iter()
+        .filter_map(|v| match v.driver {
+            sim::Driver::Planner(kind) => Some(kind.name()),
+            sim::Driver::LaneKeeping => None,
+        })
+        .collect();
+    kinds.dedup();
+    match kinds.as_slice() {
+        [] => "none".into(),
+        [one] => (*one).to_string(),
+        _ => "mixed".into(),
+    }
+}
+
+fn progress_printer(enabled: bool, label: String) -> impl FnMut(f64) {
+    let mut last = -1i64;
+    move |fraction: f64| {
+        if !enabled {
+            return;
+        }
+        let percent = (fraction * 100.0).floor() as i64;
+        if percent != last {
+            last = percent;
+            eprint!("\r{label}: {percent:3}%");
+            if percent >= 100 {
+                eprintln!();
+            }
+        }
+    }
+}
+
+struct Finished {
+    summary: RunSummary,
+    outcome: RunOutcome,
+}
+
+fn simulate(
+    scenario: &Scenario,
+    planner: Option<PlannerKind>,
+    seed: Option<u64>,
+    rrd: Option<&Path>,
+    keep_time_series: bool,
+    show_progress: bool,
+) -> Result<Finished, Failure> {
+    let label = planner_label(scenario, planner);
+    let recorder = match rrd {
+        Some(path) => Recorder::new_file(path, "mergesim")
+            .with_context(|| format!("cannot create recording {}", path.display()))
+            .map_err(run_failure)?,
+        None => Recorder::disabled(),
+    };
+    let options = RunOptions {
+        planner_override: planner,
+        seed: seed.unwrap_or(0),
+        keep_time_series,
+    };
+    let world = World::new(scenario.sim.clone(), &scenario.vehicles, &options, recorder)
+        .map_err(input)?;
+    let started = Instant::now();
+    let progress = progress_printer(show_progress, format!("{} {label}", scenario.name));
+    let outcome = world.run(progress).map_err(run_failure)?;
+    let wall_time_s = started.elapsed().as_secs_f64();
+    let summary = RunSummary::new(&scenario.name, &label, seed, wall_time_s, &outcome);
+    Ok(Finished { summary, outcome })
+}
+
+fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
+    let scenario = Scenario::load(&args.scenario).map_err(input)?;
+    let label = planner_label(&scenario, args.planner);
+    let rrd = if args.no_rrd {
+        None
+    } else {
+        Some(
+            args.rrd
+                .clone()
+                .unwrap_or_else(|| PathBuf::from(format!("{}_{label}.rrd", scenario.name))),
+        )
+    };
+    for (path, what) in [
+        (rrd.as_deref(), "--rrd"),
+        (args.json.as_deref(), "--json"),
+        (args.csv.as_deref(), "--csv"),
+    ] {
+        if let Some(path) = path {
+            check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
+        }
+    }
+    let show_progress = !args.quiet && std::io::stderr().is_terminal();
+    let finished = simulate(
+        &scenario,
+        args.planner,
+        args.seed,
+        rrd.as_deref(),
+        args.csv.is_some(),
+        show_progress,
+    )?;
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&finished.summary).map_err(run_failure)?;
+        write_atomically(path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))
+            .map_err(run_failure)?;
+    }
+    if let Some(path) = &args.csv {
+        let mut text = String::from(TimeSeriesRow::CSV_HEADER);
+        text.push('\n');
+        for row in &finished.outcome.time_series {
+            text.push_str(&row.csv_line());
+            text.push('\n');
+        }
+        write_atomically(path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))
+            .map_err(run_failure)?;
+    }
+    if !args.quiet {
+        print!("{}", finished.summary.table());
+        for event in &finished.summary.events {
+            println!("event: {event}");
+        }
+        if let Some(path) = &rrd {
+            println!("recording: {} (open with `rerun {}`)", path.display(), path.display());
+        }
+    }
+    if args.view
+        && let Some(path) = &rrd
+    {
+        std::process::Command::new("rerun")
+            .arg(path)
+            .spawn()
+            .context("cannot start the Rerun viewer `rerun` (install: pip install rerun-sdk==0.36.3)")
+            .map_err(run_failure)?;
+    }
+    Ok(())
+}
+
+fn cmd_compare(args: &CompareArgs) -> Result<(), Failure> {
+    let scenario = Scenario::load(&args.scenario).map_err(input)?;
+    if let Some(path) = &args.json {
+        check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
+    }
+    let show_progress = std::io::stderr().is_terminal();
+    let mut summaries = Vec::new();
+    for &kind in &args.planners {
+        let finished = simulate(&scenario, Some(kind), args.seed, None, false, show_progress)?;
+        summaries.push(finished.summary);
+    }
+    print!("{}", comparison_table(&summaries));
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&summaries).map_err(run_failure)?;
+        write_atomically(path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))
+            .map_err(run_failure)?;
+    }
+    Ok(())
+}
+
+fn comparison_table(summaries: &[RunSummary]) -> String {
+    let mut out = String::new();
+    out.push_str(&format!("{:<28}", "metric"));
+    for s in summaries {
+        out.push_str(&format!("{:>13}", s.planner));
+    }
+    out.push('\n');
+    let mut row = |label: &str, value: &dyn Fn(&RunSummary) -> String| {
+        out.push_str(&format!("{label:<28}"));
+        for s in summaries {
+            out.push_str(&format!("{:>13}", value(s)));
+        }
+        out.push('\n');
+    };
+    row("collisions", &|s| s.collisions.to_string());
+    row("min gap m", &|s| format!("{:.2}", s.min_gap_m));
+    row("min TTC s", &|s| {
+        s.min_ttc_s.map(|t| format!("{t:.2}")).unwrap_or_else(|| "-".into())
+    });
+    row("near miss", &|s| s.near_miss.to_string());
+    row("fallbacks", &|s| s.planner_stats.fallbacks.to_string());
+    let names: Vec<String> = summaries
+        .first()
+        .map(|s| s.vehicles.iter().map(|v| v.id.clone()).collect())
+        .unwrap_or_default();
+    for (i, name) in names.iter().enumerate() {
+        let get = |s: &RunSummary| s.vehicles.get(i).cloned();
+        row(&format!("{name} |β|max rad"), &|s| {
+            get(s).map(|v| format!("{:.4}", v.max_abs_sideslip_rad)).unwrap_or_default()
+        });
+        row(&format!("{name} |ψ|max rad"), &|s| {
+            get(s).map(|v| format!("{:.4}", v.max_abs_yaw_rad)).unwrap_or_default()
+        });
+        row(&format!("{name} |r|max rad/s"), &|s| {
+            get(s).map(|v| format!("{:.4}", v.max_abs_yaw_rate_radps)).unwrap_or_default()
+        });
+        row(&format!("{name} v_min m/s"), &|s| {
+            get(s).map(|v| format!("{:.2}", v.min_speed_mps)).unwrap_or_default()
+        });
+        row(&format!("{name} path m"), &|s| {
+            get(s).map(|v| format!("{:.1}", v.path_length_m)).unwrap_or_default()
+        });
+        row(&format!("{name} r sign changes"), &|s| {
+            get(s).map(|v| v.yaw_rate_sign_changes.to_string()).unwrap_or_default()
+        });
+    }
+    out
+}
+
+fn cmd_maneuver(args: &ManeuverArgs) -> Result<(), Failure> {
+    if let Some(path) = &args.json {
+        check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
+    }
+    let kind = match args.maneuver {
+        ManeuverName::SteadyState => ManeuverKind::SteadyState,
+        ManeuverName::StepSteer => ManeuverKind::StepSteer,
+        ManeuverName::Braking => ManeuverKind::Braking,
+    };
+    let config = ManeuverConfig {
+        kind,
+        vehicle: args.vehicle.clone(),
+        speed_mps: args.speed_mps,
+        steer_rad: args.steer_rad,
+        mu: args.mu,
+        dt_s: args.dt_s,
+        ..ManeuverConfig::default()
+    };
+    config.validate().map_err(input)?;
+    let report = run_maneuver(&config).map_err(run_failure)?;
+    let text = serde_json::to_string_pretty(&report).map_err(run_failure)?;
+    if let Some(path) = &args.json {
+        write_atomically(path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))
+            .map_err(run_failure)?;
+    }
+    println!("{text}");
+    Ok(())
+}
+
+fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
+    match cmd {
+        ScenarioCommand::List => {
+            for name in scenarios::builtin::names() {
+                let scenario = Scenario::load(name).map_err(run_failure)?;
+                println!("{name:<20} {}", scenario.description);
+            }
+        }
+        ScenarioCommand::Show { name } => {
+            let text = scenarios::builtin::toml_of(name).ok_or_else(|| {
+                input(anyhow!(
+                    "unknown built-in scenario {name:?} (built-ins: {})",
+                    scenarios::builtin::names().join(", ")
+                ))
+            })?;
+            print!("{text}");
+        }
+    }
+    Ok(())
+}

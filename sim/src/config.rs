@@ -1,0 +1,177 @@
+//! What a simulation is made of: the shared settings and the vehicles to spawn.
+
+use planner::{Lane, MergeRoad, PlannerKind, PlannerParams};
+use serde::{Deserialize, Serialize};
+use vehicles::TrackerParams;
+
+use crate::error::SimError;
+use crate::safety::SafetyParams;
+use crate::v2v::V2vParams;
+
+/// Settings shared by every vehicle of a run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimConfig {
+    /// Road geometry (shared by the planner's road field and the road collider).
+    pub road: MergeRoad,
+    /// Tire–road friction coefficient μ.
+    pub mu: f64,
+    /// Physics step (s).
+    pub dt_s: f64,
+    /// Simulated time (s).
+    pub duration_s: f64,
+    /// Planning period of every vehicle (s).
+    pub planner_period_s: f64,
+    /// Period of metrics, CSV rows and recording (s).
+    pub log_period_s: f64,
+    /// Period of the potential-field images in the recording (s).
+    pub field_log_period_s: f64,
+    /// Period of the parry safety checks (s); rounded to whole physics steps.
+    pub safety_period_s: f64,
+    /// V2V bus.
+    pub v2v: V2vParams,
+    /// Planner parameters (every PF vehicle).
+    pub planner: PlannerParams,
+    /// Path / speed tracker.
+    pub tracker: TrackerParams,
+    /// Collision, gap and TTC thresholds.
+    pub safety: SafetyParams,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        Self {
+            road: MergeRoad::default(),
+            mu: 0.8,
+            dt_s: 0.002,
+            duration_s: 25.0,
+            planner_period_s: 0.1,
+            log_period_s: 0.05,
+            field_log_period_s: 0.5,
+            safety_period_s: 0.01,
+            v2v: V2vParams::default(),
+            planner: PlannerParams::default(),
+            tracker: TrackerParams::default(),
+            safety: SafetyParams::default(),
+        }
+    }
+}
+
+impl SimConfig {
+    /// Checks every field; the error names it and its value.
+    pub fn validate(&self) -> Result<(), SimError> {
+        let bad = |name: &str, value: f64, reason: &str| SimError::InvalidParameter {
+            name: name.to_string(),
+            value,
+            reason: reason.to_string(),
+        };
+        self.road.validate().map_err(|e| SimError::InvalidScenario(e.to_string()))?;
+        if !(self.mu.is_finite() && self.mu > 0.0 && self.mu <= 2.0) {
+            return Err(bad("mu", self.mu, "must lie in (0, 2]"));
+        }
+        if !(self.dt_s.is_finite() && self.dt_s >= 1e-4 && self.dt_s <= 0.02) {
+            return Err(bad("dt_s", self.dt_s, "must lie in [0.0001, 0.02] s"));
+        }
+        if !(self.duration_s.is_finite() && self.duration_s > 0.0 && self.duration_s <= 3600.0) {
+            return Err(bad("duration_s", self.duration_s, "must lie in (0, 3600] s"));
+        }
+        for (name, value) in [
+            ("planner_period_s", self.planner_period_s),
+            ("log_period_s", self.log_period_s),
+            ("field_log_period_s", self.field_log_period_s),
+            ("safety_period_s", self.safety_period_s),
+        ] {
+            if !(value.is_finite() && value >= self.dt_s && value <= 10.0) {
+                return Err(bad(
+                    name,
+                    value,
+                    &format!("must lie in [dt_s = {}, 10] s", self.dt_s),
+                ));
+            }
+        }
+        self.v2v.validate()?;
+        self.planner
+            .validate()
+            .map_err(|e| SimError::InvalidScenario(e.to_string()))?;
+        Ok(())
+    }
+}
+
+/// How a vehicle decides its path and speed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Driver {
+    /// A potential-field planner of the given kind.
+    Planner(PlannerKind),
+    /// No planner: holds its lane centre and initial speed (for deliberately unsafe tests).
+    LaneKeeping,
+}
+
+/// One vehicle to spawn.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VehicleSpec {
+    /// Unique name (the paper's scenario: `ego`, `obstacle`).
+    pub name: String,
+    /// Vehicle preset (`bmw_320i`, `ford_escort`, `vw_vanagon`).
+    pub preset: String,
+    /// Starting lane.
+    pub lane: Lane,
+    /// Initial longitudinal position of the centre of gravity (m).
+    pub x_m: f64,
+    /// Lateral offset from the lane centre (m).
+    #[serde(default)]
+    pub y_offset_m: f64,
+    /// Initial speed (m/s).
+    pub speed_mps: f64,
+    /// Target speed V_target (m/s).
+    pub target_speed_mps: f64,
+    /// Who drives.
+    pub driver: Driver,
+    /// Whether it sends and receives shared local paths.
+    #[serde(default = "default_true")]
+    pub connected: bool,
+}
+
+fn default_true() -> bool {
+    true
+}
+
+/// Checks the vehicle list against the configuration; the error names the vehicle and field.
+pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<(), SimError> {
+    if specs.is_empty() {
+        return Err(SimError::InvalidScenario("no vehicles".into()));
+    }
+    for (i, spec) in specs.iter().enumerate() {
+        if specs[..i].iter().any(|other| other.name == spec.name) {
+            return Err(SimError::InvalidScenario(format!(
+                "duplicate vehicle name {:?}",
+                spec.name
+            )));
+        }
+        if spec.name.is_empty() || spec.name.contains([',', '"', '\n']) {
+            return Err(SimError::InvalidScenario(format!(
+                "vehicle name {:?} must be non-empty and free of commas, quotes and newlines",
+                spec.name
+            )));
+        }
+        vehicles::VehicleParams::preset(&spec.preset)?;
+        let field = |name: &str| format!("vehicles[{}].{name}", spec.name);
+        let ranges = [
+            ("x_m", spec.x_m, config.road.start_x_m, config.road.end_x_m),
+            ("y_offset_m", spec.y_offset_m, -1.0, 1.0),
+            ("speed_mps", spec.speed_mps, 0.0, 60.0),
+            ("target_speed_mps", spec.target_speed_mps, 0.5, 60.0),
+        ];
+        for (name, value, lo, hi) in ranges {
+            if !(value.is_finite() && value >= lo && value <= hi) {
+                return Err(SimError::InvalidParameter {
+                    name: field(name),
+                    value,
+                    reason: format!("must lie in [{lo}, {hi}]"),
+                });
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,117 @@
+//! The run summary: the JSON contract of `merge_sim run --json` and the human-readable table.
+
+use serde::{Deserialize, Serialize};
+use sim::{PlannerStats, RunOutcome};
+
+/// JSON summary of one run (`--json`). Field names are a contract: see the README.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// Scenario name.
+    pub scenario: String,
+    /// Planner name (`pf-iso`, ..., or `mixed`).
+    pub planner: String,
+    /// Seed of the run (null for the nominal scenario).
+    pub seed: Option<u64>,
+    /// Simulated time (s).
+    pub duration_s: f64,
+    /// Wall-clock time of the simulation (s); the only field that differs between reruns.
+    pub wall_time_s: f64,
+    /// Number of collision events (vehicle–vehicle and vehicle–road edge).
+    pub collisions: usize,
+    /// Exact minimum distance between any two vehicle boxes (m).
+    pub min_gap_m: f64,
+    /// Minimum time to collision (s); null if no pair was ever closing within the horizon.
+    pub min_ttc_s: Option<f64>,
+    /// Near miss: min TTC below the threshold or min gap below its threshold, without collision.
+    pub near_miss: bool,
+    /// Time spent with TTC below the threshold (s).
+    pub tet_s: f64,
+    /// Per-vehicle metrics.
+    pub vehicles: Vec<sim::metrics::VehicleMetricsSummary>,
+    /// Planner counters and timing.
+    pub planner_stats: PlannerStats,
+    /// Collision and safety events, in time order.
+    pub events: Vec<String>,
+}
+
+impl RunSummary {
+    /// Builds the summary of a finished run.
+    pub fn new(
+        scenario: &str,
+        planner: &str,
+        seed: Option<u64>,
+        wall_time_s: f64,
+        outcome: &RunOutcome,
+    ) -> Self {
+        Self {
+            scenario: scenario.to_string(),
+            planner: planner.to_string(),
+            seed,
+            duration_s: outcome.duration_s,
+            wall_time_s,
+            collisions: outcome.safety.collisions.len(),
+            min_gap_m: outcome.safety.min_gap_m,
+            min_ttc_s: outcome.safety.min_ttc_s,
+            near_miss: outcome.safety.near_miss,
+            tet_s: outcome.safety.tet_s,
+            vehicles: outcome.vehicles.clone(),
+            planner_stats: outcome.planner_stats.clone(),
+            events: outcome.events.clone(),
+        }
+    }
+
+    /// A fixed-width table for the terminal.
+    pub fn table(&self) -> String {
+        let mut out = String::new();
+        let ttc = self
+            .min_ttc_s
+            .map(|t| format!("{t:.2} s"))
+            .unwrap_or_else(|| "never closing".into());
+        out.push_str(&format!(
+            "scenario {}  planner {}  simulated {:.1} s in {:.2} s wall\n",
+            self.scenario, self.planner, self.duration_s, self.wall_time_s
+        ));
+        out.push_str(&format!(
+            "collisions {}  min gap {:.2} m  min TTC {}  near miss {}  TET {:.2} s\n",
+            self.collisions,
+            self.min_gap_m,
+            ttc,
+            if self.near_miss { "yes" } else { "no" },
+            self.tet_s
+        ));
+        out.push_str(&format!(
+            "planner cycles {}  fallbacks {}  p50 {:.0} µs  p99 {:.0} µs\n\n",
+            self.planner_stats.plans,
+            self.planner_stats.fallbacks,
+            self.planner_stats.p50_plan_us,
+            self.planner_stats.p99_plan_us
+        ));
+        out.push_str(&format!(
+            "{:<10} {:>11} {:>9} {:>12} {:>10} {:>10} {:>9} {:>8} {:>8}\n",
+            "vehicle",
+            "|β|max rad",
+            "|ψ|max",
+            "|r|max rad/s",
+            "v_min m/s",
+            "at t s",
+            "path m",
+            "r flips",
+            "collided"
+        ));
+        for v in &self.vehicles {
+            out.push_str(&format!(
+                "{:<10} {:>11.4} {:>9.4} {:>12.4} {:>10.2} {:>10.2} {:>9.1} {:>8} {:>8}\n",
+                v.id,
+                v.max_abs_sideslip_rad,
+                v.max_abs_yaw_rad,
+                v.max_abs_yaw_rate_radps,
+                v.min_speed_mps,
+                v.t_min_speed_s,
+                v.path_length_m,
+                v.yaw_rate_sign_changes,
+                if v.collided { "yes" } else { "no" }
+            ));
+        }
+        out
+    }
+}
