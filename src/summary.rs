@@ -18,8 +18,8 @@ pub struct RunSummary {
     pub wall_time_s: f64,
     /// Number of collision events (vehicle–vehicle and vehicle–road edge).
     pub collisions: usize,
-    /// Exact minimum distance between any two vehicle boxes (m).
-    pub min_gap_m: f64,
+    /// Exact minimum distance between any two vehicle boxes (m); null with a single vehicle.
+    pub min_gap_m: Option<f64>,
     /// Minimum time to collision (s); null if no pair was ever closing within the horizon.
     pub min_ttc_s: Option<f64>,
     /// Near miss: min TTC below the threshold or min gap below its threshold, without collision.
@@ -49,7 +49,7 @@ impl RunSummary {
             seed,
             duration_s: outcome.duration_s,
             wall_time_s,
-            collisions: outcome.safety.collisions.len(),
+            collisions: outcome.safety.collisions.len() + outcome.safety.edge_contacts.len(),
             min_gap_m: outcome.safety.min_gap_m,
             min_ttc_s: outcome.safety.min_ttc_s,
             near_miss: outcome.safety.near_miss,
@@ -72,9 +72,11 @@ impl RunSummary {
             self.scenario, self.planner, self.duration_s, self.wall_time_s
         ));
         out.push_str(&format!(
-            "collisions {}  min gap {:.2} m  min TTC {}  near miss {}  TET {:.2} s\n",
+            "collisions {}  min gap {}  min TTC {}  near miss {}  TET {:.2} s\n",
             self.collisions,
-            self.min_gap_m,
+            self.min_gap_m
+                .map(|g| format!("{g:.2} m"))
+                .unwrap_or_else(|| "-".into()),
             ttc,
             if self.near_miss { "yes" } else { "no" },
             self.tet_s

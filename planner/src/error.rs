@@ -21,6 +21,16 @@ pub enum PlannerError {
         /// Where it was found.
         what: String,
     },
+    /// A name (e.g. of a planner) that is not one of the valid ones.
+    #[error("unknown {what} '{given}'; valid: {valid}")]
+    UnknownName {
+        /// What was being named (`planner`).
+        what: String,
+        /// The name given.
+        given: String,
+        /// The valid names, comma separated.
+        valid: String,
+    },
     /// The convex solver did not reach a usable solution.
     #[error("solver failed in {problem}: status {status}")]
     SolverFailed {

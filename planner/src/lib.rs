@@ -2,11 +2,28 @@
 //! constrained cubic fit (Eqs. 8–9) and interactive speed optimisation (Eq. 10).
 //!
 //! No physics engine, no logging backend: plain state in, plan out, so it can run on a car.
+//! `planner/README.md` maps each equation of the paper to the function implementing it and
+//! lists every reading of a typo or unit problem.
 
+pub mod attractive_field;
+pub mod cubic_fit;
 pub mod error;
+pub mod fallback;
+pub mod local_path;
+pub mod obstacle_field;
+pub mod params;
+pub mod planners;
+pub mod polyline;
+pub mod potential_field;
+pub mod prediction;
 pub mod road;
+pub mod road_field;
+pub mod speed_optimisation;
 pub mod types;
 
 pub use error::PlannerError;
+pub use params::PlannerParams;
+pub use planners::{PfPlanner, PlanRequest, PlanStats, PlannerKind};
+pub use potential_field::{GridSpec, PotentialField};
 pub use road::{Lane, MergeRoad};
 pub use types::*;

@@ -18,7 +18,9 @@ pub enum SimError {
     /// Something about the scenario's vehicles is inconsistent (duplicate ids, ...).
     #[error("invalid scenario: {0}")]
     InvalidScenario(String),
-    // LEAD-TODO: Vehicle(#[from] vehicles::VehicleError) once the vehicles crate exists.
+    /// The vehicle model refused its parameters or state.
+    #[error(transparent)]
+    Vehicle(#[from] vehicles::VehicleError),
     /// The planner refused its input.
     #[error("planner of vehicle {vehicle}: {source}")]
     Planner {

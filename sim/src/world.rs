@@ -21,8 +21,12 @@ use vehicles::{Kinematics, PhysicsWorld, Tracker, Vehicle, VehicleParams};
 use crate::config::{Driver, SimConfig, VehicleSpec};
 use crate::error::SimError;
 use crate::metrics::{MetricsSample, VehicleMetrics, VehicleMetricsSummary};
-use crate::recording::Recorder;
+use crate::recording::{EventLevel, Recorder};
 use crate::safety::{BodyState, SafetyMonitor, SafetySummary};
+
+fn rec(e: crate::recording::RecordingError) -> SimError {
+    SimError::Recording(e.to_string())
+}
 use crate::v2v::{V2vBus, V2vStats};
 
 /// One row of the time series (`--csv`).
@@ -151,6 +155,7 @@ pub struct World {
     steps_per_field: u64,
     steps_per_safety: u64,
     reported_collisions: usize,
+    reported_edge_contacts: usize,
 }
 
 fn steps_for(period_s: f64, dt_s: f64) -> u64 {
@@ -174,7 +179,8 @@ impl World {
             agents.push(Self::spawn_agent(&config, &mut physics, index, spec, options)?);
         }
         let bus = V2vBus::new(config.v2v.clone(), crate::rng::SplitMix64::derive(options.seed, 1))?;
-        let safety = SafetyMonitor::new(config.safety.clone(), config.road.clone());
+        let safety = SafetyMonitor::new(config.safety.clone(), &config.road)
+            .map_err(|e| SimError::InvalidScenario(e.to_string()))?;
         let mut world = Self {
             steps_per_plan: steps_for(config.planner_period_s, config.dt_s),
             steps_per_log: steps_for(config.log_period_s, config.dt_s),
@@ -193,8 +199,9 @@ impl World {
             fallbacks: 0,
             step_index: 0,
             reported_collisions: 0,
+            reported_edge_contacts: 0,
         };
-        world.recorder.log_road(&world.config.road);
+        world.recorder.log_road(&world.config.road).map_err(rec)?;
         Ok(world)
     }
 
@@ -208,12 +215,7 @@ impl World {
         let params = VehicleParams::preset(&spec.preset)?;
         let y_m = config.road.lane_center_y_m(spec.lane) + spec.y_offset_m;
         let vehicle = Vehicle::spawn(physics, &params, spec.x_m, y_m, 0.0, spec.speed_mps)?;
-        let shape = VehicleShape {
-            length_m: params.length_m,
-            width_m: params.width_m,
-            wheelbase_m: params.lf_m + params.lr_m,
-            max_brake_decel_mps2: config.planner.max_brake_decel_mps2,
-        };
+        let shape = vehicle.shape(VehicleShape::default().max_brake_decel_mps2);
         let planner = match spec.driver {
             Driver::Planner(kind) => {
                 let kind = options.planner_override.unwrap_or(kind);
@@ -302,12 +304,17 @@ impl World {
             }
             if need_safety {
                 let bodies = self.body_states(&kins);
-                self.safety.check(t_s, &bodies, self.config.safety_period_s);
-                self.report_new_collisions(t_s);
+                self.safety
+                    .check(t_s, &bodies, self.config.safety_period_s)
+                    .map_err(|e| SimError::Diverged {
+                        t_s,
+                        what: e.to_string(),
+                    })?;
+                self.report_new_collisions()?;
             }
             // 6. Metrics, time series, recording.
             if need_log {
-                self.log_instant(t_s, &kins);
+                self.log_instant(t_s, &kins)?;
             }
         }
         Ok(())
@@ -329,18 +336,19 @@ impl World {
                     yaw_rate_radps: k.yaw_rate_radps,
                     length_m: agent.shape.length_m,
                     width_m: agent.shape.width_m,
-                    height_m: agent.vehicle.params().height_m,
+                    height_m: agent.vehicle.params().body_height_m,
                 }
             })
             .collect()
     }
 
-    fn report_new_collisions(&mut self, t_s: f64) {
+    fn report_new_collisions(&mut self) -> Result<(), SimError> {
+        let names = self.names();
         let collisions = self.safety.collision_events();
         while self.reported_collisions < collisions.len() {
             let event = &collisions[self.reported_collisions];
-            let text = event.describe(&self.names());
-            self.recorder.log_event(&text, "ERROR");
+            let text = event.describe(&names);
+            self.recorder.log_event(&text, EventLevel::Error).map_err(rec)?;
             self.events.push(text);
             for agent in &mut self.agents {
                 if event.involves(agent.id) {
@@ -349,7 +357,24 @@ impl World {
             }
             self.reported_collisions += 1;
         }
-        let _ = t_s;
+        let contacts = self.safety.edge_contact_events();
+        while self.reported_edge_contacts < contacts.len() {
+            let event = &contacts[self.reported_edge_contacts];
+            let name = names.get(event.id as usize).cloned().unwrap_or_default();
+            let text = format!(
+                "t = {:.3} s: vehicle {name} hit the {:?} road edge",
+                event.t_s, event.edge
+            );
+            self.recorder.log_event(&text, EventLevel::Error).map_err(rec)?;
+            self.events.push(text);
+            for agent in &mut self.agents {
+                if agent.id == event.id {
+                    agent.metrics.set_collided();
+                }
+            }
+            self.reported_edge_contacts += 1;
+        }
+        Ok(())
     }
 
     fn names(&self) -> Vec<String> {
@@ -418,11 +443,11 @@ impl World {
                     "t = {t_s:.2} s: planner fallback of {}: {reason:?}",
                     agent.spec.name
                 );
-                self.recorder.log_event(&text, "WARN");
+                self.recorder.log_event(&text, EventLevel::Warn).map_err(rec)?;
                 self.events.push(text);
             }
             if self.step_index % self.steps_per_field == 0 && self.recorder.is_enabled() {
-                log_field(&mut self.recorder, planner, &request, &agent.spec.name);
+                log_field(&mut self.recorder, planner, &request, &agent.spec.name)?;
             }
             agent.path = plan.path.clone();
             if agent.spec.connected {
@@ -442,12 +467,12 @@ impl World {
         Ok(())
     }
 
-    fn log_instant(&mut self, t_s: f64, kins: &[Kinematics]) {
+    fn log_instant(&mut self, t_s: f64, kins: &[Kinematics]) -> Result<(), SimError> {
         let bodies = self.body_states(kins);
         let names = self.names();
         if self.recorder.is_enabled() {
-            self.recorder.set_time(t_s);
-            self.recorder.log_vehicles(&bodies, &names);
+            self.recorder.set_time(t_s).map_err(rec)?;
+            self.recorder.log_vehicles(&bodies, &names).map_err(rec)?;
         }
         for (agent, k) in self.agents.iter_mut().zip(kins) {
             let planned_speed_mps = planned_speed_at(&agent.path, t_s).unwrap_or(k.speed_mps);
@@ -461,7 +486,11 @@ impl World {
                 speed_mps: k.speed_mps,
                 accel_long_mps2: k.accel_long_mps2,
                 accel_lat_mps2: k.accel_lat_mps2,
-            });
+            })
+            .map_err(|e| SimError::Diverged {
+                t_s,
+                what: format!("metrics of {}: {e}", agent.spec.name),
+            })?;
             if self.recorder.is_enabled() {
                 let name = &agent.spec.name;
                 self.recorder.log_scalars(
@@ -473,11 +502,11 @@ impl World {
                         ("speed_mps", k.speed_mps),
                         ("planned_speed_mps", planned_speed_mps),
                     ],
-                );
-                self.recorder.log_planned_path(name, &agent.path);
+                ).map_err(rec)?;
+                self.recorder.log_planned_path(name, &agent.path).map_err(rec)?;
                 if agent.spec.connected {
                     let received = self.bus.fresh_paths(agent.id, t_s);
-                    self.recorder.log_received_paths(name, &received);
+                    self.recorder.log_received_paths(name, &received).map_err(rec)?;
                 }
             }
             if self.keep_time_series {
@@ -496,20 +525,24 @@ impl World {
                 });
             }
         }
+        Ok(())
     }
 
     fn finish(mut self) -> Result<RunOutcome, SimError> {
         let safety = self.safety.summary();
         if safety.near_miss {
             let text = format!(
-                "near miss: min gap {:.2} m, min TTC {}",
-                safety.min_gap_m,
+                "near miss: min gap {} m, min TTC {}",
+                safety
+                    .min_gap_m
+                    .map(|g| format!("{g:.2}"))
+                    .unwrap_or_else(|| "-".into()),
                 safety
                     .min_ttc_s
                     .map(|t| format!("{t:.2} s"))
                     .unwrap_or_else(|| "none".into())
             );
-            self.recorder.log_event(&text, "WARN");
+            self.recorder.log_event(&text, EventLevel::Warn).map_err(rec)?;
             self.events.push(text);
         }
         let mut times = self.plan_times_us.clone();
@@ -523,9 +556,7 @@ impl World {
         let vehicles = self.agents.iter().map(|a| a.metrics.summary()).collect();
         let v2v = self.bus.stats();
         let duration_s = self.time_s();
-        self.recorder
-            .finish()
-            .map_err(|e| SimError::Recording(e.to_string()))?;
+        self.recorder.finish().map_err(rec)?;
         Ok(RunOutcome {
             duration_s,
             safety,
@@ -592,7 +623,12 @@ fn lane_keeping_path(config: &SimConfig, spec: &VehicleSpec, k: &Kinematics, t_s
 }
 
 /// Samples the ego's potential field on a window around it and logs it as an image.
-fn log_field(recorder: &mut Recorder, planner: &PfPlanner, request: &PlanRequest, name: &str) {
+fn log_field(
+    recorder: &mut Recorder,
+    planner: &PfPlanner,
+    request: &PlanRequest,
+    name: &str,
+) -> Result<(), SimError> {
     let cell_m = 0.5;
     let x0_m = request.ego.x_m - 20.0;
     let road = planner.road();
@@ -607,5 +643,7 @@ fn log_field(recorder: &mut Recorder, planner: &PfPlanner, request: &PlanRequest
             values.push(planner.field_value(request, x_m, y_m));
         }
     }
-    recorder.log_field(name, x0_m, y0_m, cell_m, width, height, &values);
+    recorder
+        .log_field(name, x0_m, y0_m, cell_m, width, height, &values)
+        .map_err(rec)
 }

@@ -355,7 +355,9 @@ fn comparison_table(summaries: &[RunSummary]) -> String {
         out.push('\n');
     };
     row("collisions", &|s| s.collisions.to_string());
-    row("min gap m", &|s| format!("{:.2}", s.min_gap_m));
+    row("min gap m", &|s| {
+        s.min_gap_m.map(|g| format!("{g:.2}")).unwrap_or_else(|| "-".into())
+    });
     row("min TTC s", &|s| {
         s.min_ttc_s.map(|t| format!("{t:.2}")).unwrap_or_else(|| "-".into())
     });

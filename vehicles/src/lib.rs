@@ -1,1 +1,42 @@
-//! vehicles
+//! Vehicles of mergesim: a rapier rigid-body car on four ray-cast wheels with a slip-based
+//! Magic-Formula tyre model, the path tracker that drives it, and the standard handling
+//! maneuvers used to validate it against textbook references.
+//!
+//! World frame: X along the road, Y left, Z up, gravity (0, 0, −9.81). The API speaks `f64`
+//! SI units; rapier works in `f32` inside.
+//!
+//! Order of one physics tick (for the simulator):
+//! ```text
+//! controls = tracker.update(&vehicle.kinematics(&world), &path, dt);
+//! vehicle.set_controls(controls);
+//! vehicle.apply_forces(&mut world, mu);   // every vehicle, in id order
+//! world.step();
+//! ```
+
+pub mod collision_groups;
+pub mod controls;
+pub mod error;
+pub mod kinematics;
+pub mod maneuver;
+pub mod params;
+pub mod physics_world;
+pub mod presets;
+pub mod road_collider;
+pub mod single_track;
+pub mod tire;
+pub mod tracker;
+pub mod vehicle;
+pub mod wheel;
+
+pub use controls::{Controls, WHEEL_NAMES};
+pub use error::VehicleError;
+pub use kinematics::Kinematics;
+pub use maneuver::{ManeuverConfig, ManeuverKind, ManeuverReport, run_maneuver};
+pub use params::{TireParams, VehicleParams};
+pub use physics_world::{GRAVITY_MPS2, PhysicsWorld};
+pub use presets::PRESET_NAMES;
+pub use road_collider::{RoadColliderParams, RoadColliders};
+pub use single_track::{LinearSingleTrack, linear_yaw_rate_radps};
+pub use tracker::{SpeedController, Tracker, TrackerParams};
+pub use vehicle::{BodyBox, Vehicle};
+pub use wheel::WheelTelemetry;

@@ -1,0 +1,347 @@
+//! Every tunable number of the planner, in one struct with `Default` and a serde form.
+//!
+//! Units: the potential U is dimensionless; gains carry the units that make it so
+//! (λ in 1/m², ξ in m²). The attractive pull λ·look-ahead (1/m) is the unit force against
+//! which all lateral forces compare: the heading of a path step is atan2(F_y, F_x), so only
+//! the ratio of the forces matters, never their absolute size.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::PlannerError;
+
+/// Smallest number of waypoints: a cubic has four coefficients (paper, after Eq. 9).
+pub const MIN_WAYPOINTS: usize = 4;
+
+/// Largest number of waypoints accepted (keeps the speed problem small and bounded).
+pub const MAX_WAYPOINTS: usize = 200;
+
+/// Standard gravity g (m/s²) of the friction speed limit √(μ g / |κ|) (Eq. 10a).
+pub const GRAVITY_MPS2: f64 = 9.806_65;
+
+/// Parameters of the potential-field planner (paper Eqs. 1–10).
+///
+/// Defaults are chosen for the paper's urgent merge (two 3.5 m lanes, ego at 20 m/s, obstacle
+/// at 15 m/s): see the field docs and `planner/README.md` for the reasoning.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlannerParams {
+    // ---------------------------------------------------------------- Eq. 1 (attractive)
+    /// λ, slope scale of the attractive field U_AT = ½ λ (X − X_tar)² (1/m²).
+    pub attractive_gain_per_m2: f64,
+    /// Distance of the moving target X_tar ahead of the point being stepped (m). The pull is
+    /// then the constant λ·look-ahead = the unit of force (default 0.05 · 20 = 1).
+    pub target_lookahead_m: f64,
+
+    // ---------------------------------------------------------------- Eq. 2 (lane divider)
+    /// A_lane, height of the lane-divider ridge. With the edge gain below, the default puts the
+    /// lateral equilibrium of each lane within a few centimetres of its centre.
+    pub lane_amplitude: f64,
+    /// σ of the lane-divider Gaussian (m).
+    pub lane_sigma_m: f64,
+
+    // ---------------------------------------------------------------- Eq. 3 (road edges)
+    /// ξ, scale of the edge field ½ ξ / (d − l_w/2)² (m²).
+    pub edge_gain_m2: f64,
+    /// Clearance (d − l_w/2) below which the edge field continues linearly with the slope it has
+    /// there, so it stays finite (and keeps pushing) on and beyond the edge (m).
+    pub edge_clamp_distance_m: f64,
+
+    // ---------------------------------------------------------------- Eq. 4 (obstacles)
+    /// A_obs, peak of an obstacle's field.
+    pub obstacle_amplitude: f64,
+    /// ε, the field level (absolute) at the lateral safety distance. Must be below
+    /// `obstacle_amplitude`.
+    pub obstacle_epsilon: f64,
+    /// Lateral safety distance at which an obstacle's field has fallen to ε (m): fixes σ_y.
+    pub obstacle_lateral_safety_m: f64,
+    /// Fraction of A_obs left at the longitudinal safety distance D_min: fixes σ_x.
+    pub obstacle_fraction_at_min_distance: f64,
+    /// Time gap added to D_min for the follower, v_f · τ (s); 0 gives the paper's D_min.
+    pub obstacle_time_gap_s: f64,
+    /// M of the planning vehicle in D_min, as a dimensionless factor.
+    pub ego_mass_factor: f64,
+    /// M_o of the other vehicle in D_min, as a dimensionless factor.
+    pub other_mass_factor: f64,
+
+    // ---------------------------------------------------------------- Eq. 7 (waypoints)
+    /// N, number of waypoints (≥ 4).
+    pub waypoint_count: usize,
+    /// Δt_plan, time per waypoint step: L_s = v·Δt_plan, and the time grid of the interaction
+    /// term (s). N · Δt_plan is the horizon of the shared local path.
+    pub step_time_s: f64,
+    /// Smallest step L_s (m), used at low speed.
+    pub min_step_m: f64,
+    /// Evaluate each obstacle's field at its constant-velocity position at the time the ego
+    /// reaches the waypoint being stepped (k·Δt_plan) instead of at its current position.
+    /// The paper steps against the current positions (off by default for fidelity); with it on,
+    /// a faster ego no longer plans to slip into the gap the slower car occupies now but will
+    /// have left when the ego arrives.
+    pub predict_obstacles_in_path: bool,
+    /// Longest sub-step of the gradient integration inside one waypoint step (m). The paper's
+    /// Eq. 7 is one sub-step per waypoint; shorter sub-steps follow the force's stream line
+    /// instead of zig-zagging over the divider ridge when L_s is several metres.
+    pub max_substep_m: f64,
+
+    // ---------------------------------------------------------------- Eqs. 8–9 (cubic fit)
+    /// Weight of the vehicle's own position as a data point of the fit (waypoints weigh 1).
+    pub cubic_origin_weight: f64,
+    /// Bound on |a0|, the lateral offset of the path at the vehicle (m).
+    pub cubic_max_offset_m: f64,
+    /// Bound on the path heading at the vehicle, relative to the vehicle (rad): |a1| ≤ S·tan.
+    pub cubic_max_heading_rad: f64,
+    /// Bound on the curvature at the vehicle (1/m): |a2| ≤ S²·κ_max/2.
+    pub cubic_max_curvature_per_m: f64,
+    /// Bound on the curvature rate (1/m²): |a3| ≤ S³·κ'_max/6.
+    pub cubic_max_curvature_rate_per_m2: f64,
+
+    // ---------------------------------------------------------------- Eq. 10 (speeds)
+    /// V_limit, the speed limit (m/s).
+    pub speed_limit_mps: f64,
+    /// v_min, lower bound on every speed (m/s, > 0): keeps the travel-time term Δs/v finite.
+    /// The paper's bound 0 ≤ v_i is read as v_min ≤ v_i; a full stop is outside this problem.
+    pub min_speed_mps: f64,
+    /// w1, weight of the travel time Σ Δs_i / v_i (1/s).
+    pub travel_time_weight: f64,
+    /// w2, weight of the speed deviation Σ ½ (v_i − V_target)² (s²/m²).
+    pub speed_deviation_weight: f64,
+    /// w3, weight of the interaction term Σ ln U_SLP^i (0 turns PF-ISO into PF-SP).
+    pub interaction_weight: f64,
+    /// Floor of the interaction term, ln(floor + Σ U_OB) (same unit as A_obs). The term acts
+    /// where the others' fields exceed it and fades below: with the default (= the field's
+    /// fraction at D_min) a vehicle further than D_min ahead or behind, or a lane away, leaves
+    /// the speeds alone. The paper's ε (far smaller) would make ln U pull hardest near the ε
+    /// contour, i.e. at 3–4 σ_x, so vehicles at a safe following distance keep pushing each
+    /// other's speeds away from their targets.
+    pub interaction_floor: f64,
+    /// Half-width of the SCP trust region on each speed after the first iteration (m/s).
+    pub trust_region_mps: f64,
+    /// Maximum number of SCP iterations (each one convex solve; ≥ 1).
+    pub max_scp_iterations: usize,
+    /// SCP stops when the objective falls by less than this fraction of its magnitude.
+    pub scp_relative_tolerance: f64,
+    /// Bound consecutive speeds by |v_{i+1} − v_i| ≤ a_max · Δt_plan (and v_1 against the
+    /// current speed when that is feasible).
+    pub accel_bound_enabled: bool,
+    /// a_max of the acceleration bound (m/s²).
+    pub max_accel_mps2: f64,
+    /// Bound |v_{i+1} − 2 v_i + v_{i−1}| ≤ j_max · Δt_plan².
+    pub jerk_bound_enabled: bool,
+    /// j_max of the jerk bound (m/s³).
+    pub max_jerk_mps3: f64,
+    /// Interior-point iteration limit of each convex solve (Clarabel `max_iter`); 0 makes every
+    /// solve fail, which exercises the fallback.
+    pub solver_max_iterations: u32,
+    /// Clarabel's gap and feasibility tolerances.
+    pub solver_tolerance: f64,
+    /// A shared local path older than this is ignored in favour of a constant-velocity
+    /// prediction (s).
+    pub max_shared_path_age_s: f64,
+
+    // ---------------------------------------------------------------- faults
+    /// Comfortable deceleration of the fallback plan (m/s², positive).
+    pub fallback_decel_mps2: f64,
+}
+
+impl Default for PlannerParams {
+    fn default() -> Self {
+        Self {
+            attractive_gain_per_m2: 0.05,
+            target_lookahead_m: 20.0,
+            lane_amplitude: 0.03,
+            lane_sigma_m: 1.0,
+            edge_gain_m2: 0.01,
+            edge_clamp_distance_m: 0.1,
+            obstacle_amplitude: 1.0,
+            obstacle_epsilon: 0.002,
+            obstacle_lateral_safety_m: 3.5,
+            obstacle_fraction_at_min_distance: 0.1,
+            obstacle_time_gap_s: 1.0,
+            ego_mass_factor: 1.0,
+            other_mass_factor: 1.0,
+            waypoint_count: 20,
+            step_time_s: 0.25,
+            min_step_m: 1.0,
+            max_substep_m: 1.0,
+            predict_obstacles_in_path: false,
+            cubic_origin_weight: 10.0,
+            cubic_max_offset_m: 0.5,
+            cubic_max_heading_rad: 0.35,
+            cubic_max_curvature_per_m: 0.05,
+            cubic_max_curvature_rate_per_m2: 0.005,
+            speed_limit_mps: 30.0,
+            min_speed_mps: 0.5,
+            travel_time_weight: 1.0,
+            speed_deviation_weight: 1.0,
+            interaction_weight: 10.0,
+            interaction_floor: 0.1,
+            trust_region_mps: 2.0,
+            max_scp_iterations: 2,
+            scp_relative_tolerance: 1e-4,
+            accel_bound_enabled: true,
+            max_accel_mps2: 3.0,
+            jerk_bound_enabled: false,
+            max_jerk_mps3: 10.0,
+            solver_max_iterations: 50,
+            solver_tolerance: 1e-7,
+            max_shared_path_age_s: 0.5,
+            fallback_decel_mps2: 2.0,
+        }
+    }
+}
+
+fn invalid(name: &str, value: f64, reason: &str) -> PlannerError {
+    PlannerError::InvalidParameter {
+        name: format!("planner.{name}"),
+        value,
+        reason: reason.into(),
+    }
+}
+
+impl PlannerParams {
+    /// Checks every field; the error names the first offending field and its value.
+    pub fn validate(&self) -> Result<(), PlannerError> {
+        let positive = [
+            ("attractive_gain_per_m2", self.attractive_gain_per_m2),
+            ("target_lookahead_m", self.target_lookahead_m),
+            ("lane_sigma_m", self.lane_sigma_m),
+            ("edge_clamp_distance_m", self.edge_clamp_distance_m),
+            ("obstacle_amplitude", self.obstacle_amplitude),
+            ("obstacle_epsilon", self.obstacle_epsilon),
+            ("interaction_floor", self.interaction_floor),
+            ("obstacle_lateral_safety_m", self.obstacle_lateral_safety_m),
+            ("ego_mass_factor", self.ego_mass_factor),
+            ("other_mass_factor", self.other_mass_factor),
+            ("step_time_s", self.step_time_s),
+            ("min_step_m", self.min_step_m),
+            ("max_substep_m", self.max_substep_m),
+            ("cubic_max_offset_m", self.cubic_max_offset_m),
+            ("cubic_max_heading_rad", self.cubic_max_heading_rad),
+            ("cubic_max_curvature_per_m", self.cubic_max_curvature_per_m),
+            (
+                "cubic_max_curvature_rate_per_m2",
+                self.cubic_max_curvature_rate_per_m2,
+            ),
+            ("speed_limit_mps", self.speed_limit_mps),
+            ("min_speed_mps", self.min_speed_mps),
+            ("speed_deviation_weight", self.speed_deviation_weight),
+            ("trust_region_mps", self.trust_region_mps),
+            ("max_accel_mps2", self.max_accel_mps2),
+            ("max_jerk_mps3", self.max_jerk_mps3),
+            ("solver_tolerance", self.solver_tolerance),
+            ("fallback_decel_mps2", self.fallback_decel_mps2),
+        ];
+        for (name, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(invalid(name, value, "must be finite and > 0"));
+            }
+        }
+        let non_negative = [
+            ("lane_amplitude", self.lane_amplitude),
+            ("edge_gain_m2", self.edge_gain_m2),
+            ("obstacle_time_gap_s", self.obstacle_time_gap_s),
+            ("cubic_origin_weight", self.cubic_origin_weight),
+            ("travel_time_weight", self.travel_time_weight),
+            ("interaction_weight", self.interaction_weight),
+            ("scp_relative_tolerance", self.scp_relative_tolerance),
+            ("max_shared_path_age_s", self.max_shared_path_age_s),
+        ];
+        for (name, value) in non_negative {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(invalid(name, value, "must be finite and >= 0"));
+            }
+        }
+        if self.obstacle_epsilon >= self.obstacle_amplitude {
+            return Err(invalid(
+                "obstacle_epsilon",
+                self.obstacle_epsilon,
+                "must be below planner.obstacle_amplitude (σ_y = d/√(−2 ln(ε/A)))",
+            ));
+        }
+        let fraction = self.obstacle_fraction_at_min_distance;
+        if !(fraction > 0.0 && fraction < 1.0) {
+            return Err(invalid(
+                "obstacle_fraction_at_min_distance",
+                fraction,
+                "must lie in (0, 1)",
+            ));
+        }
+        if self.cubic_max_heading_rad >= std::f64::consts::FRAC_PI_2 {
+            return Err(invalid(
+                "cubic_max_heading_rad",
+                self.cubic_max_heading_rad,
+                "must be below π/2",
+            ));
+        }
+        if !(MIN_WAYPOINTS..=MAX_WAYPOINTS).contains(&self.waypoint_count) {
+            return Err(invalid(
+                "waypoint_count",
+                self.waypoint_count as f64,
+                &format!("must lie in [{MIN_WAYPOINTS}, {MAX_WAYPOINTS}] (a cubic needs 4 points)"),
+            ));
+        }
+        if self.min_speed_mps >= self.speed_limit_mps {
+            return Err(invalid(
+                "min_speed_mps",
+                self.min_speed_mps,
+                "must be below planner.speed_limit_mps",
+            ));
+        }
+        if self.max_scp_iterations == 0 {
+            return Err(invalid(
+                "max_scp_iterations",
+                0.0,
+                "must be >= 1 (the first iteration is the convex solve itself)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The attractive pull λ·look-ahead of the moving target (1/m), the unit of force.
+    pub fn attractive_pull_per_m(&self) -> f64 {
+        self.attractive_gain_per_m2 * self.target_lookahead_m
+    }
+
+    /// Waypoint step L_s = max(v·Δt_plan, L_min) for a speed (m).
+    pub fn step_length_m(&self, speed_mps: f64) -> f64 {
+        (speed_mps.max(0.0) * self.step_time_s).max(self.min_step_m)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_is_valid() {
+        PlannerParams::default().validate().unwrap();
+    }
+
+    #[test]
+    fn too_few_waypoints_is_rejected_by_name() {
+        let params = PlannerParams {
+            waypoint_count: 3,
+            ..PlannerParams::default()
+        };
+        let err = params.validate().unwrap_err().to_string();
+        assert!(err.contains("waypoint_count"), "{err}");
+    }
+
+    #[test]
+    fn nan_is_rejected_by_name() {
+        let params = PlannerParams {
+            lane_sigma_m: f64::NAN,
+            ..PlannerParams::default()
+        };
+        let err = params.validate().unwrap_err().to_string();
+        assert!(err.contains("lane_sigma_m"), "{err}");
+    }
+
+    #[test]
+    fn unknown_fields_are_rejected() {
+        let text = r#"{"waypoint_count": 10, "no_such_field": 1.0}"#;
+        assert!(serde_json::from_str::<PlannerParams>(text).is_err());
+        let partial: PlannerParams = serde_json::from_str(r#"{"waypoint_count": 10}"#).unwrap();
+        assert_eq!(partial.waypoint_count, 10);
+        assert_eq!(partial.step_time_s, PlannerParams::default().step_time_s);
+    }
+}

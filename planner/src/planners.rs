@@ -1,0 +1,551 @@
+//! The four planners behind one interface: PF-CS, PF-SP, PF-ISO and PF-ISO-PRED.
+//!
+//! Every planner generates the path the same way (Eqs. 1–9); they differ in the speeds:
+//!
+//! | kind          | speeds                                                                 |
+//! |---------------|------------------------------------------------------------------------|
+//! | `pf-cs`       | constant V_target (Wang et al. 2022 baseline)                          |
+//! | `pf-sp`       | Eq. 10 with w3 = 0: travel time, target speed, friction limit (Wu et al.) |
+//! | `pf-iso`      | Eq. 10 with the received shared local paths (a constant-velocity prediction for a neighbour whose SLP is missing or stale) |
+//! | `pf-iso-pred` | Eq. 10 with every neighbour predicted at constant velocity (no V2V)   |
+//!
+//! One planning cycle: universal field from the perceived neighbours (Eqs. 1–5) → N gradient
+//! steps of L_s = v·Δt_plan (Eqs. 6–7) → constrained cubic fit in the vehicle frame (Eqs. 8–9)
+//! → speeds (Eq. 10) → the path to track (cubic sampled at the waypoints, with speeds and
+//! absolute times t_i = t_0 + Σ_{j ≤ i} Δs_j / v_j) and the SLP to broadcast.
+
+use std::collections::BTreeMap;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use crate::cubic_fit::{FitMethod, fit_path_cubic};
+use crate::error::PlannerError;
+use crate::fallback::{FallbackInput, fallback_plan};
+use crate::local_path::local_path;
+use crate::obstacle_field::{ObstacleField, SelfView};
+use crate::params::PlannerParams;
+use crate::polyline::Polyline;
+use crate::potential_field::{GridSpec, PotentialField};
+use crate::prediction::Trajectory;
+use crate::road::MergeRoad;
+use crate::speed_optimisation::{
+    InteractionTerm, SpeedOptimiser, SpeedProblem, friction_speed_limits,
+};
+use crate::types::{
+    FallbackReason, Neighbour, PathPoint, Plan, SharedLocalPath, TimedWaypoint, VehicleId,
+    VehicleShape, VehicleState,
+};
+
+/// Which planner a vehicle runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PlannerKind {
+    /// PF path, constant speed V_target.
+    PfCs,
+    /// PF path, speed planning without interaction (Eq. 10 with w3 = 0).
+    PfSp,
+    /// PF path, interactive speed optimisation with the shared local paths (Eq. 10).
+    PfIso,
+    /// Like PF-ISO with the others' paths predicted at constant velocity (no V2V).
+    PfIsoPred,
+}
+
+impl PlannerKind {
+    /// Every kind, in a fixed order.
+    pub const ALL: [PlannerKind; 4] = [
+        PlannerKind::PfCs,
+        PlannerKind::PfSp,
+        PlannerKind::PfIso,
+        PlannerKind::PfIsoPred,
+    ];
+
+    /// The kebab-case name (`pf-cs`, `pf-sp`, `pf-iso`, `pf-iso-pred`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            PlannerKind::PfCs => "pf-cs",
+            PlannerKind::PfSp => "pf-sp",
+            PlannerKind::PfIso => "pf-iso",
+            PlannerKind::PfIsoPred => "pf-iso-pred",
+        }
+    }
+}
+
+impl std::fmt::Display for PlannerKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for PlannerKind {
+    type Err = PlannerError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        PlannerKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| PlannerError::UnknownName {
+                what: "planner".into(),
+                given: s.into(),
+                valid: PlannerKind::ALL.map(|k| k.name()).join(", "),
+            })
+    }
+}
+
+/// The input of one planning cycle.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanRequest<'a> {
+    /// Planning time (s).
+    pub time_s: f64,
+    /// The planning vehicle.
+    pub ego_id: VehicleId,
+    /// Its state.
+    pub ego: VehicleState,
+    /// Its footprint and braking.
+    pub ego_shape: VehicleShape,
+    /// V_target (m/s).
+    pub target_speed_mps: f64,
+    /// Tire–road friction μ.
+    pub mu: f64,
+    /// Other vehicles' current states (perception): obstacle fields of Eq. 4.
+    pub neighbours: &'a [Neighbour],
+    /// Fresh SLPs received over V2V (PF-ISO uses them).
+    pub shared_paths: &'a [SharedLocalPath],
+}
+
+/// What the last planning cycle did (for statistics and the benchmark).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlanStats {
+    /// Convex speed solves of the cycle.
+    pub speed_solves: usize,
+    /// Whether the cubic fit needed the QP (a bound was active).
+    pub cubic_qp: bool,
+    /// Number of other vehicles in the interaction term.
+    pub interacting_vehicles: usize,
+    /// Whether the plan is a fallback.
+    pub fallback: bool,
+}
+
+/// A potential-field planner of one vehicle. Holds the last good plan (for the fallback and
+/// to warm-start the speed optimisation) and the speed optimiser's solver.
+#[derive(Clone, Debug)]
+pub struct PfPlanner {
+    kind: PlannerKind,
+    params: PlannerParams,
+    road: MergeRoad,
+    last_good: Option<Plan>,
+    optimiser: SpeedOptimiser,
+    stats: PlanStats,
+}
+
+fn non_finite(what: &str) -> PlannerError {
+    PlannerError::NonFinite { what: what.into() }
+}
+
+fn check_state(state: &VehicleState, what: &str) -> Result<(), PlannerError> {
+    let values = [state.x_m, state.y_m, state.yaw_rad, state.speed_mps];
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(non_finite(what))
+    }
+}
+
+fn check_shape(shape: &VehicleShape, what: &str) -> Result<(), PlannerError> {
+    let fields = [
+        ("length_m", shape.length_m),
+        ("width_m", shape.width_m),
+        ("wheelbase_m", shape.wheelbase_m),
+        ("max_brake_decel_mps2", shape.max_brake_decel_mps2),
+    ];
+    for (name, value) in fields {
+        if !value.is_finite() {
+            return Err(non_finite(&format!("{what}.{name}")));
+        }
+        if value <= 0.0 {
+            return Err(PlannerError::InvalidParameter {
+                name: format!("{what}.{name}"),
+                value,
+                reason: "must be > 0".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks a request: every number finite, shapes positive, μ > 0, V_target ≥ 0.
+pub fn validate_request(req: &PlanRequest<'_>) -> Result<(), PlannerError> {
+    if !req.time_s.is_finite() {
+        return Err(non_finite("request.time_s"));
+    }
+    check_state(&req.ego, "request.ego")?;
+    check_shape(&req.ego_shape, "request.ego_shape")?;
+    if !req.target_speed_mps.is_finite() {
+        return Err(non_finite("request.target_speed_mps"));
+    }
+    if req.target_speed_mps < 0.0 {
+        return Err(PlannerError::InvalidParameter {
+            name: "request.target_speed_mps".into(),
+            value: req.target_speed_mps,
+            reason: "must be >= 0".into(),
+        });
+    }
+    if !req.mu.is_finite() {
+        return Err(non_finite("request.mu"));
+    }
+    if req.mu <= 0.0 {
+        return Err(PlannerError::InvalidParameter {
+            name: "request.mu".into(),
+            value: req.mu,
+            reason: "must be > 0".into(),
+        });
+    }
+    for n in req.neighbours {
+        check_state(&n.state, &format!("neighbour {}", n.id))?;
+        check_shape(&n.shape, &format!("neighbour {}.shape", n.id))?;
+    }
+    for m in req.shared_paths {
+        let what = format!("shared path of {}", m.vehicle_id);
+        if !(m.stamp_s.is_finite() && m.speed_mps.is_finite()) {
+            return Err(non_finite(&what));
+        }
+        check_shape(&m.shape, &format!("{what}.shape"))?;
+        if m
+            .waypoints
+            .iter()
+            .any(|w| !(w.t_s.is_finite() && w.x_m.is_finite() && w.y_m.is_finite()))
+        {
+            return Err(non_finite(&what));
+        }
+    }
+    Ok(())
+}
+
+/// Speed of `path` at absolute time `t_s` (the speed held from the last point reached).
+fn speed_at_time(path: &[PathPoint], t_s: f64) -> Option<f64> {
+    let k = path.partition_point(|p| p.t_s <= t_s);
+    path.get(k.saturating_sub(1)).map(|p| p.speed_mps)
+}
+
+/// A cycle's failure, with whatever was computed before it (for the fallback).
+struct CycleFailure {
+    error: PlannerError,
+    waypoints: Option<Vec<[f64; 2]>>,
+}
+
+impl PfPlanner {
+    /// A planner of `kind`; fails if the parameters or the road are invalid.
+    pub fn new(kind: PlannerKind, params: PlannerParams, road: MergeRoad) -> Result<Self, PlannerError> {
+        params.validate()?;
+        road.validate()?;
+        Ok(Self {
+            kind,
+            params,
+            road,
+            last_good: None,
+            optimiser: SpeedOptimiser::new(),
+            stats: PlanStats::default(),
+        })
+    }
+
+    /// The planner kind.
+    pub fn kind(&self) -> PlannerKind {
+        self.kind
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &PlannerParams {
+        &self.params
+    }
+
+    /// The road.
+    pub fn road(&self) -> &MergeRoad {
+        &self.road
+    }
+
+    /// What the last cycle did.
+    pub fn last_stats(&self) -> PlanStats {
+        self.stats
+    }
+
+    /// The last plan that was not a fallback.
+    pub fn last_good_plan(&self) -> Option<&Plan> {
+        self.last_good.as_ref()
+    }
+
+    /// The universal field of the request's ego (Eq. 5).
+    pub fn field<'s>(&'s self, req: &PlanRequest<'_>) -> PotentialField<'s> {
+        PotentialField::new(
+            &self.params,
+            &self.road,
+            req.ego_id,
+            &req.ego,
+            &req.ego_shape,
+            req.neighbours,
+        )
+    }
+
+    /// Universal potential U at (x, y) seen by the ego of `req` (for drawing the field). It
+    /// includes the attractive bowl ½ λ (X − X_tar)², which dominates far from the ego: see
+    /// [`PfPlanner::repulsive_field_value`] for a drawing of the road and obstacles only.
+    pub fn field_value(&self, req: &PlanRequest<'_>, x_m: f64, y_m: f64) -> f64 {
+        self.field(req).value(x_m, y_m)
+    }
+
+    /// U_LD + U_RE + Σ U_OB at (x, y) seen by the ego of `req` (no attraction).
+    pub fn repulsive_field_value(&self, req: &PlanRequest<'_>, x_m: f64, y_m: f64) -> f64 {
+        self.field(req).repulsive_value(x_m, y_m)
+    }
+
+    /// U on a grid (row after row, cell centres; see [`GridSpec`]).
+    pub fn field_grid(
+        &self,
+        req: &PlanRequest<'_>,
+        spec: &GridSpec,
+        include_attractive: bool,
+    ) -> Result<Vec<f64>, PlannerError> {
+        self.field(req).grid(spec, include_attractive)
+    }
+
+    /// One planning cycle. Never panics. `Err` only for invalid input (non-finite state,
+    /// non-positive shape, …); a solver failure or a non-finite intermediate returns `Ok` with
+    /// `plan.fallback = Some(..)`: a comfortable deceleration along the last good path.
+    pub fn plan(&mut self, req: &PlanRequest<'_>) -> Result<Plan, PlannerError> {
+        validate_request(req)?;
+        self.stats = PlanStats::default();
+        match self.plan_cycle(req) {
+            Ok(plan) => {
+                self.last_good = Some(plan.clone());
+                Ok(plan)
+            }
+            Err(failure) => {
+                let reason = match &failure.error {
+                    PlannerError::NonFinite { what } => FallbackReason::NonFinite(what.clone()),
+                    other => FallbackReason::SolverFailed(other.to_string()),
+                };
+                self.stats.fallback = true;
+                let input = FallbackInput {
+                    time_s: req.time_s,
+                    ego_id: req.ego_id,
+                    ego: &req.ego,
+                    ego_shape: &req.ego_shape,
+                    last_good: self.last_good.as_ref(),
+                    waypoints: failure.waypoints.as_deref(),
+                };
+                Ok(fallback_plan(&self.params, &input, reason))
+            }
+        }
+    }
+
+    /// The others' motion for the interaction term, by id: (trajectory, speed, shape).
+    fn others(&self, req: &PlanRequest<'_>) -> BTreeMap<VehicleId, (Trajectory, f64, VehicleShape)> {
+        let mut others = BTreeMap::new();
+        if self.kind == PlannerKind::PfIso {
+            // The newest fresh SLP of each sender.
+            let mut newest: BTreeMap<VehicleId, &SharedLocalPath> = BTreeMap::new();
+            for m in req.shared_paths {
+                let age_s = req.time_s - m.stamp_s;
+                if m.vehicle_id == req.ego_id || age_s > self.params.max_shared_path_age_s {
+                    continue;
+                }
+                match newest.get(&m.vehicle_id) {
+                    Some(old) if old.stamp_s >= m.stamp_s => {}
+                    _ => {
+                        newest.insert(m.vehicle_id, m);
+                    }
+                }
+            }
+            for (id, m) in newest {
+                let yaw = req
+                    .neighbours
+                    .iter()
+                    .find(|n| n.id == id)
+                    .map_or(0.0, |n| n.state.yaw_rad);
+                if let Some(trajectory) = Trajectory::from_shared(m, yaw) {
+                    others.insert(id, (trajectory, m.speed_mps, m.shape));
+                }
+            }
+        }
+        if matches!(self.kind, PlannerKind::PfIso | PlannerKind::PfIsoPred) {
+            for n in req.neighbours {
+                if n.id == req.ego_id || others.contains_key(&n.id) {
+                    continue;
+                }
+                let trajectory = Trajectory::ConstantVelocity {
+                    state: n.state,
+                    time_s: req.time_s,
+                };
+                others.insert(n.id, (trajectory, n.state.speed_mps, n.shape));
+            }
+        }
+        others
+    }
+
+    fn plan_cycle(&mut self, req: &PlanRequest<'_>) -> Result<Plan, CycleFailure> {
+        let params = &self.params;
+        let n = params.waypoint_count;
+        let fail = |error: PlannerError, waypoints: Option<Vec<[f64; 2]>>| CycleFailure {
+            error,
+            waypoints,
+        };
+
+        // Eqs. 1–7: waypoints by gradient steps.
+        let field = PotentialField::new(
+            params,
+            &self.road,
+            req.ego_id,
+            &req.ego,
+            &req.ego_shape,
+            req.neighbours,
+        );
+        let step_m = params.step_length_m(req.ego.speed_mps);
+        let time_per_step_s = if params.predict_obstacles_in_path {
+            params.step_time_s
+        } else {
+            0.0
+        };
+        let waypoints = local_path(
+            &field,
+            [req.ego.x_m, req.ego.y_m],
+            step_m,
+            n,
+            params.max_substep_m,
+            time_per_step_s,
+        );
+        if waypoints.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(fail(non_finite("potential-field waypoints"), None));
+        }
+
+        // Eqs. 8–9: cubic in the vehicle frame.
+        let (cubic, xis) = fit_path_cubic(params, [req.ego.x_m, req.ego.y_m], req.ego.yaw_rad, &waypoints)
+            .map_err(|e| fail(e, Some(waypoints.clone())))?;
+        self.stats.cubic_qp = cubic.method == FitMethod::Qp;
+        let points: Vec<[f64; 2]> = xis.iter().map(|xi| cubic.world_point(*xi)).collect();
+        if points.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(fail(non_finite("fitted path"), Some(waypoints)));
+        }
+        let line = Polyline::with_start([req.ego.x_m, req.ego.y_m], points.iter().copied());
+        let segment_lengths_m = line.segment_lengths_m();
+
+        // Eq. 10: speeds.
+        let speeds_mps = match self.kind {
+            PlannerKind::PfCs => vec![
+                req.target_speed_mps.clamp(params.min_speed_mps, params.speed_limit_mps);
+                n
+            ],
+            PlannerKind::PfSp | PlannerKind::PfIso | PlannerKind::PfIsoPred => {
+                let max_speeds_mps = friction_speed_limits(
+                    |xi| cubic.curvature_per_m(xi),
+                    &xis,
+                    req.mu,
+                    params.speed_limit_mps,
+                );
+                let interaction = if self.kind == PlannerKind::PfSp {
+                    None
+                } else {
+                    let others = self.others(req);
+                    self.stats.interacting_vehicles = others.len();
+                    (!others.is_empty()).then(|| {
+                        let me = SelfView {
+                            speed_mps: req.ego.speed_mps,
+                            shape: req.ego_shape,
+                        };
+                        let bases: Vec<(ObstacleField, &Trajectory)> = others
+                            .values()
+                            .map(|(trajectory, speed, shape)| {
+                                (ObstacleField::new(params, me, 0.0, 0.0, 0.0, *speed, shape), trajectory)
+                            })
+                            .collect();
+                        let fields = (1..=n)
+                            .map(|i| {
+                                let t_s = req.time_s + i as f64 * params.step_time_s;
+                                bases
+                                    .iter()
+                                    .map(|(base, trajectory)| {
+                                        let pose = trajectory.pose_at(t_s);
+                                        base.moved_to(pose.xy_m[0], pose.xy_m[1], pose.heading[0], pose.heading[1])
+                                    })
+                                    .collect()
+                            })
+                            .collect();
+                        let (sin_yaw, cos_yaw) = req.ego.yaw_rad.sin_cos();
+                        InteractionTerm::new(
+                            line.clone(),
+                            [cos_yaw, sin_yaw],
+                            params.step_time_s,
+                            params.interaction_floor,
+                            fields,
+                        )
+                    })
+                };
+                // Warm start: the last good plan's speeds at the same absolute times.
+                let guess: Option<Vec<f64>> = self.last_good.as_ref().and_then(|last| {
+                    (1..=n)
+                        .map(|i| speed_at_time(&last.path, req.time_s + (i as f64 - 0.5) * params.step_time_s))
+                        .collect()
+                });
+                let problem = SpeedProblem {
+                    current_speed_mps: req.ego.speed_mps,
+                    target_speed_mps: req.target_speed_mps,
+                    segment_lengths_m: &segment_lengths_m,
+                    max_speeds_mps: &max_speeds_mps,
+                    initial_guess_mps: guess.as_deref(),
+                    interaction: interaction.as_ref(),
+                };
+                let solution = self
+                    .optimiser
+                    .solve(params, &problem)
+                    .map_err(|e| fail(e, Some(waypoints.clone())))?;
+                self.stats.speed_solves = solution.solves;
+                solution.speeds_mps
+            }
+        };
+
+        // The path to track and the SLP: t_i = t_0 + Σ Δs_j / v_j.
+        let mut path = Vec::with_capacity(n + 1);
+        let mut t_s = req.time_s;
+        path.push(PathPoint {
+            x_m: req.ego.x_m,
+            y_m: req.ego.y_m,
+            speed_mps: speeds_mps[0],
+            t_s,
+        });
+        for (k, p) in points.iter().enumerate() {
+            t_s += segment_lengths_m[k] / speeds_mps[k];
+            path.push(PathPoint {
+                x_m: p[0],
+                y_m: p[1],
+                speed_mps: speeds_mps[(k + 1).min(n - 1)],
+                t_s,
+            });
+        }
+        if path
+            .iter()
+            .any(|p| !(p.x_m.is_finite() && p.y_m.is_finite() && p.speed_mps.is_finite() && p.t_s.is_finite()))
+        {
+            return Err(fail(non_finite("planned path"), Some(waypoints)));
+        }
+        let shared = SharedLocalPath {
+            vehicle_id: req.ego_id,
+            stamp_s: req.time_s,
+            shape: req.ego_shape,
+            speed_mps: req.ego.speed_mps,
+            waypoints: path
+                .iter()
+                .map(|p| TimedWaypoint {
+                    t_s: p.t_s,
+                    x_m: p.x_m,
+                    y_m: p.y_m,
+                })
+                .collect(),
+        };
+        Ok(Plan {
+            waypoints,
+            path,
+            cubic: cubic.coefficients,
+            cubic_x_scale_m: cubic.x_scale_m,
+            shared,
+            fallback: None,
+        })
+    }
+}

@@ -1,0 +1,288 @@
+//! The universal potential field U_uni = U_AT + U_LD + U_RE + Σ_j U_OB^j and its force
+//! F_uni = −∇U_uni (paper Eq. 5), plus sampling on a grid for drawing.
+
+use crate::attractive_field::AttractiveField;
+use crate::error::PlannerError;
+use crate::obstacle_field::{ObstacleField, SelfView};
+use crate::params::PlannerParams;
+use crate::road::MergeRoad;
+use crate::road_field::RoadField;
+use crate::types::{Neighbour, VehicleId, VehicleShape, VehicleState};
+
+/// Largest grid accepted by [`PotentialField::grid`] (cells).
+pub const MAX_GRID_CELLS: usize = 16 * 1024 * 1024;
+
+/// A regular grid of cell centres: cell (row, col) is at
+/// (x_min + (col + ½)·cell, y_min + (row + ½)·cell); values are stored row after row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridSpec {
+    /// Left edge of the window (m).
+    pub x_min_m: f64,
+    /// Bottom edge of the window (m).
+    pub y_min_m: f64,
+    /// Cell size (m).
+    pub cell_m: f64,
+    /// Number of cells along X.
+    pub columns: usize,
+    /// Number of cells along Y.
+    pub rows: usize,
+}
+
+impl GridSpec {
+    /// Checks that the grid is finite, non-empty and not absurdly large.
+    pub fn validate(&self) -> Result<(), PlannerError> {
+        for (name, value) in [("x_min_m", self.x_min_m), ("y_min_m", self.y_min_m)] {
+            if !value.is_finite() {
+                return Err(PlannerError::InvalidParameter {
+                    name: format!("grid.{name}"),
+                    value,
+                    reason: "must be finite".into(),
+                });
+            }
+        }
+        if !(self.cell_m.is_finite() && self.cell_m > 0.0) {
+            return Err(PlannerError::InvalidParameter {
+                name: "grid.cell_m".into(),
+                value: self.cell_m,
+                reason: "must be finite and > 0".into(),
+            });
+        }
+        let cells = self.columns.saturating_mul(self.rows);
+        if cells == 0 || cells > MAX_GRID_CELLS {
+            return Err(PlannerError::InvalidParameter {
+                name: "grid.columns × grid.rows".into(),
+                value: cells as f64,
+                reason: format!("must lie in [1, {MAX_GRID_CELLS}]"),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The universal field seen by one planning vehicle at one planning instant.
+#[derive(Clone, Debug)]
+pub struct PotentialField<'a> {
+    /// Eq. 1 with the target a look-ahead ahead of the vehicle.
+    pub attractive: AttractiveField,
+    /// Look-ahead of the moving target (m).
+    pub lookahead_m: f64,
+    /// Eqs. 2–3.
+    pub road: RoadField<'a>,
+    /// Eq. 4, one per other vehicle, in the order of the neighbours given.
+    pub obstacles: Vec<ObstacleField>,
+    /// Each obstacle's velocity (m/s), for [`PotentialField::stepping_force_at`].
+    pub obstacle_velocities_mps: Vec<[f64; 2]>,
+}
+
+impl<'a> PotentialField<'a> {
+    /// The field of vehicle `ego_id` at `ego` among `neighbours` (its own entry is skipped).
+    pub fn new(
+        params: &PlannerParams,
+        road: &'a MergeRoad,
+        ego_id: VehicleId,
+        ego: &VehicleState,
+        ego_shape: &VehicleShape,
+        neighbours: &[Neighbour],
+    ) -> Self {
+        let me = SelfView {
+            speed_mps: ego.speed_mps,
+            shape: *ego_shape,
+        };
+        let others: Vec<&Neighbour> = neighbours.iter().filter(|n| n.id != ego_id).collect();
+        let obstacle_velocities_mps = others
+            .iter()
+            .map(|n| {
+                let (s, c) = n.state.yaw_rad.sin_cos();
+                [n.state.speed_mps * c, n.state.speed_mps * s]
+            })
+            .collect();
+        let obstacles = others
+            .iter()
+            .map(|n| {
+                ObstacleField::new(
+                    params,
+                    me,
+                    n.state.x_m,
+                    n.state.y_m,
+                    n.state.yaw_rad,
+                    n.state.speed_mps,
+                    &n.shape,
+                )
+            })
+            .collect();
+        Self {
+            attractive: AttractiveField {
+                gain_per_m2: params.attractive_gain_per_m2,
+                target_x_m: ego.x_m + params.target_lookahead_m,
+            },
+            lookahead_m: params.target_lookahead_m,
+            road: RoadField {
+                road,
+                lane_amplitude: params.lane_amplitude,
+                lane_sigma_m: params.lane_sigma_m,
+                edge_gain_m2: params.edge_gain_m2,
+                edge_clamp_distance_m: params.edge_clamp_distance_m,
+                half_width_m: 0.5 * ego_shape.width_m,
+            },
+            obstacles,
+            obstacle_velocities_mps,
+        }
+    }
+
+    /// U_LD + U_RE + Σ U_OB: everything but the attraction (what a drawing usually wants:
+    /// the attraction is a bowl of size ½ λ Δx² that swamps the rest).
+    pub fn repulsive_value(&self, x_m: f64, y_m: f64) -> f64 {
+        self.road.value(x_m, y_m)
+            + self
+                .obstacles
+                .iter()
+                .map(|o| o.value(x_m, y_m))
+                .sum::<f64>()
+    }
+
+    /// U_uni (Eq. 5) with the target fixed at ego X + look-ahead.
+    pub fn value(&self, x_m: f64, y_m: f64) -> f64 {
+        self.attractive.value(x_m) + self.repulsive_value(x_m, y_m)
+    }
+
+    /// ∇(U_LD + U_RE + Σ U_OB).
+    pub fn repulsive_gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
+        let mut g = self.road.gradient(x_m, y_m);
+        for o in &self.obstacles {
+            let go = o.gradient(x_m, y_m);
+            g[0] += go[0];
+            g[1] += go[1];
+        }
+        g
+    }
+
+    /// ∇U_uni with the target fixed at ego X + look-ahead.
+    pub fn gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
+        let mut g = self.repulsive_gradient(x_m, y_m);
+        g[0] += self.attractive.gradient(x_m)[0];
+        g
+    }
+
+    /// F_uni = −∇U_uni (Eq. 5) with the moving target of Eq. 1 (a constant pull
+    /// λ·look-ahead along +X): the force that steps the local path (Eqs. 6–7).
+    pub fn stepping_force(&self, x_m: f64, y_m: f64) -> [f64; 2] {
+        let g = self.repulsive_gradient(x_m, y_m);
+        let pull =
+            AttractiveField::moving_target_gradient(self.attractive.gain_per_m2, self.lookahead_m);
+        [-(g[0] + pull[0]), -(g[1] + pull[1])]
+    }
+
+    /// [`PotentialField::stepping_force`] with every obstacle moved along its velocity for
+    /// `elapsed_s` (constant-velocity prediction; 0 gives the current positions).
+    pub fn stepping_force_at(&self, x_m: f64, y_m: f64, elapsed_s: f64) -> [f64; 2] {
+        if elapsed_s == 0.0 {
+            return self.stepping_force(x_m, y_m);
+        }
+        let mut g = self.road.gradient(x_m, y_m);
+        for (o, v) in self.obstacles.iter().zip(&self.obstacle_velocities_mps) {
+            // The field moves with the obstacle: evaluate it at the point shifted back.
+            let go = o.gradient(x_m - v[0] * elapsed_s, y_m - v[1] * elapsed_s);
+            g[0] += go[0];
+            g[1] += go[1];
+        }
+        let pull =
+            AttractiveField::moving_target_gradient(self.attractive.gain_per_m2, self.lookahead_m);
+        [-(g[0] + pull[0]), -(g[1] + pull[1])]
+    }
+
+    /// Samples U (with or without the attraction) on a grid, row after row.
+    pub fn grid(&self, spec: &GridSpec, include_attractive: bool) -> Result<Vec<f64>, PlannerError> {
+        spec.validate()?;
+        let mut values = Vec::with_capacity(spec.columns * spec.rows);
+        for row in 0..spec.rows {
+            let y_m = spec.y_min_m + (row as f64 + 0.5) * spec.cell_m;
+            for col in 0..spec.columns {
+                let x_m = spec.x_min_m + (col as f64 + 0.5) * spec.cell_m;
+                values.push(if include_attractive {
+                    self.value(x_m, y_m)
+                } else {
+                    self.repulsive_value(x_m, y_m)
+                });
+            }
+        }
+        Ok(values)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(x_m: f64, y_m: f64, yaw_rad: f64, speed_mps: f64) -> VehicleState {
+        VehicleState {
+            x_m,
+            y_m,
+            yaw_rad,
+            speed_mps,
+        }
+    }
+
+    #[test]
+    fn universal_gradient_matches_central_differences() {
+        let params = PlannerParams::default();
+        let road = MergeRoad::default();
+        let neighbours = [
+            Neighbour {
+                id: 1,
+                state: state(40.0, 5.25, 0.05, 15.0),
+                shape: VehicleShape::default(),
+            },
+            Neighbour {
+                id: 2,
+                state: state(10.0, 1.9, -0.1, 22.0),
+                shape: VehicleShape::default(),
+            },
+        ];
+        let ego = state(20.0, 1.75, 0.0, 20.0);
+        let field = PotentialField::new(&params, &road, 0, &ego, &VehicleShape::default(), &neighbours);
+        assert_eq!(field.obstacles.len(), 2);
+        let h = 1e-6;
+        for (x, y) in [(25.0, 2.0), (38.0, 3.5), (45.0, 4.9), (12.0, 2.6), (180.0, 2.5)] {
+            let g = field.gradient(x, y);
+            let fx = (field.value(x + h, y) - field.value(x - h, y)) / (2.0 * h);
+            let fy = (field.value(x, y + h) - field.value(x, y - h)) / (2.0 * h);
+            assert!((g[0] - fx).abs() < 1e-6 * (1.0 + fx.abs()), "({x},{y}) x: {} vs {fx}", g[0]);
+            assert!((g[1] - fy).abs() < 1e-6 * (1.0 + fy.abs()), "({x},{y}) y: {} vs {fy}", g[1]);
+        }
+    }
+
+    #[test]
+    fn own_entry_among_neighbours_is_skipped() {
+        let params = PlannerParams::default();
+        let road = MergeRoad::default();
+        let ego = state(0.0, 1.75, 0.0, 20.0);
+        let neighbours = [Neighbour {
+            id: 7,
+            state: ego,
+            shape: VehicleShape::default(),
+        }];
+        let field = PotentialField::new(&params, &road, 7, &ego, &VehicleShape::default(), &neighbours);
+        assert!(field.obstacles.is_empty());
+    }
+
+    #[test]
+    fn grid_samples_cell_centres_row_after_row() {
+        let params = PlannerParams::default();
+        let road = MergeRoad::default();
+        let ego = state(0.0, 1.75, 0.0, 20.0);
+        let field = PotentialField::new(&params, &road, 0, &ego, &VehicleShape::default(), &[]);
+        let spec = GridSpec {
+            x_min_m: -10.0,
+            y_min_m: 0.0,
+            cell_m: 0.5,
+            columns: 7,
+            rows: 3,
+        };
+        let values = field.grid(&spec, true).unwrap();
+        assert_eq!(values.len(), 21);
+        // Row 2, column 5 is at (−10 + 5.5·0.5, 0 + 2.5·0.5).
+        assert_eq!(values[2 * 7 + 5], field.value(-7.25, 1.25));
+        let bad = GridSpec { cell_m: 0.0, ..spec };
+        assert!(field.grid(&bad, true).is_err());
+    }
+}

@@ -1,0 +1,195 @@
+//! The `merge_sim` binary as a user runs it: outputs, contracts and bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn merge_sim(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_merge_sim"))
+        .args(args)
+        .output()
+        .expect("merge_sim runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn run_writes_json_and_csv_that_follow_the_contract() {
+    let dir = scratch("contract");
+    let json = dir.join("run.json");
+    let csv = dir.join("run.csv");
+    let out = merge_sim(&[
+        "run",
+        "--no-rrd",
+        "--quiet",
+        "--json",
+        json.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for key in [
+        "scenario", "planner", "seed", "duration_s", "wall_time_s", "collisions", "min_gap_m",
+        "min_ttc_s", "near_miss", "vehicles", "planner_stats",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key} in {v}");
+    }
+    assert_eq!(v["scenario"], "urgent_merge");
+    assert_eq!(v["planner"], "pf-iso");
+    assert!((v["duration_s"].as_f64().unwrap() - 25.0).abs() < 1e-6);
+    let vehicles = v["vehicles"].as_array().unwrap();
+    let ids: Vec<&str> = vehicles.iter().map(|x| x["id"].as_str().unwrap()).collect();
+    assert_eq!(ids, ["ego", "obstacle"]);
+    for vehicle in vehicles {
+        for key in [
+            "max_abs_sideslip_rad", "max_abs_yaw_rad", "max_abs_yaw_rate_radps", "min_speed_mps",
+            "t_min_speed_s", "path_length_m", "yaw_rate_sign_changes", "collided",
+        ] {
+            assert!(vehicle.get(key).is_some(), "missing vehicles[].{key}");
+        }
+        // 25 s at 10–20 m/s: the path length must be physically plausible.
+        let length = vehicle["path_length_m"].as_f64().unwrap();
+        assert!(length > 150.0 && length < 600.0, "{length}");
+    }
+    for key in ["plans", "fallbacks", "p50_plan_us", "p99_plan_us"] {
+        assert!(v["planner_stats"].get(key).is_some(), "missing planner_stats.{key}");
+    }
+    // Two vehicles planning at 10 Hz for 25 s.
+    assert_eq!(v["planner_stats"]["plans"].as_u64().unwrap(), 2 * 250);
+
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "t_s,vehicle,x_m,y_m,yaw_rad,yaw_rate_radps,sideslip_rad,speed_mps,planned_speed_mps,accel_long_mps2,accel_lat_mps2"
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert!(rows.iter().all(|r| r.len() == 11));
+    // Both vehicles at every logged instant (20 Hz × 25 s).
+    assert_eq!(rows.len(), 2 * 500);
+    assert!(rows.iter().all(|r| r[1] == "ego" || r[1] == "obstacle"));
+    assert!(rows.iter().all(|r| r.iter().skip(2).all(|x| x.parse::<f64>().unwrap().is_finite())));
+}
+
+#[test]
+fn recording_is_written_and_verifies_with_the_rerun_cli() {
+    let dir = scratch("rrd");
+    let rrd = dir.join("run.rrd");
+    let out = merge_sim(&["run", "--quiet", "--rrd", rrd.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let size = std::fs::metadata(&rrd).unwrap().len();
+    assert!(size > 10_000, "recording only {size} bytes");
+    // No temporary file left beside it.
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name() != "run.rrd")
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    let verify = Command::new("rerun")
+        .args(["rrd", "verify"])
+        .arg(&rrd)
+        .output()
+        .expect("the Rerun CLI (pip install rerun-sdk==0.36.3, done by .ci/run) is on PATH");
+    assert!(verify.status.success(), "rerun rrd verify: {}", stderr(&verify));
+}
+
+#[test]
+fn bad_input_exits_2_naming_the_value_and_writes_nothing() {
+    let dir = scratch("bad");
+    let json = dir.join("out.json");
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (vec!["run".into(), "--scenario".into(), "nowhere".into()], "nowhere"),
+        (vec!["run".into(), "--planner".into(), "pf-xyz".into()], "pf-xyz"),
+        (vec!["maneuver".into(), "braking".into(), "--vehicle".into(), "tesla".into()], "tesla"),
+        (vec!["maneuver".into(), "braking".into(), "--mu".into(), "0".into()], "mu"),
+        (vec!["maneuver".into(), "braking".into(), "--mu".into(), "-0.3".into()], "-0.3"),
+        (vec!["maneuver".into(), "braking".into(), "--speed-mps".into(), "NaN".into()], "NaN"),
+        (vec!["run".into(), "--json".into(), "/no/such/dir/x.json".into()], "/no/such/dir"),
+    ];
+    for (mut args, needle) in cases {
+        if !args.iter().any(|a| a == "--json") {
+            args.extend(["--json".to_string(), json.to_str().unwrap().to_string()]);
+        }
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = merge_sim(&refs);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+        assert!(!stderr(&out).contains("panicked"), "{}", stderr(&out));
+        assert!(!json.exists(), "{args:?} left {}", json.display());
+    }
+    let empty: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    assert!(empty.is_empty());
+}
+
+#[test]
+fn bad_scenario_file_names_the_field() {
+    let dir = scratch("bad_file");
+    let path = dir.join("bad.toml");
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/builtin/urgent_merge.toml"),
+    )
+    .unwrap()
+    .replace("mu = 0.8", "mu = 7.5");
+    std::fs::write(&path, text).unwrap();
+    let out = merge_sim(&["run", "--no-rrd", "--scenario", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("mu") && stderr(&out).contains("7.5"), "{}", stderr(&out));
+}
+
+#[test]
+fn scenario_show_reads_back_unchanged() {
+    let dir = scratch("show");
+    let out = merge_sim(&["scenario", "show", "urgent_merge"]);
+    assert!(out.status.success());
+    let path = dir.join("urgent.toml");
+    std::fs::write(&path, &out.stdout).unwrap();
+    let a = scenarios::Scenario::load("urgent_merge").unwrap();
+    let b = scenarios::Scenario::load(path.to_str().unwrap()).unwrap();
+    assert_eq!(a, b);
+    let list = merge_sim(&["scenario", "list"]);
+    assert!(String::from_utf8_lossy(&list.stdout).contains("urgent_merge"));
+}
+
+#[test]
+fn maneuver_json_has_the_documented_keys() {
+    let dir = scratch("maneuver");
+    let json = dir.join("m.json");
+    let out = merge_sim(&[
+        "maneuver", "steady-state", "--speed-mps", "15", "--steer-rad", "0.01", "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for key in [
+        "maneuver", "vehicle", "speed_mps", "steer_rad", "mu", "yaw_rate_radps", "sideslip_rad",
+        "lat_accel_mps2", "params",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}: {v}");
+    }
+    for key in [
+        "mass_kg", "yaw_inertia_kgm2", "lf_m", "lr_m", "cornering_stiffness_front_npr",
+        "cornering_stiffness_rear_npr",
+    ] {
+        assert!(v["params"].get(key).is_some(), "missing params.{key}");
+    }
+    assert_eq!(v["vehicle"], "bmw_320i");
+    // Left steer at 15 m/s: positive yaw rate of the order of the kinematic v·δ/L.
+    let r = v["yaw_rate_radps"].as_f64().unwrap();
+    assert!(r > 0.03 && r < 0.07, "{r}");
+    let braking = merge_sim(&["maneuver", "braking", "--speed-mps", "20"]);
+    assert!(braking.status.success(), "{}", stderr(&braking));
+    let b: serde_json::Value = serde_json::from_slice(&braking.stdout).unwrap();
+    let d = b["stopping_distance_m"].as_f64().unwrap();
+    let reference = 20.0f64.powi(2) / (2.0 * 0.8 * 9.81);
+    assert!(d > 0.95 * reference && d < 1.3 * reference, "{d} vs {reference}");
+}

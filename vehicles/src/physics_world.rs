@@ -1,0 +1,218 @@
+//! The rapier world the vehicles live in: sets, pipeline, gravity and a fixed step.
+
+use rapier3d::prelude::{
+    ColliderBuilder, ColliderHandle, ColliderSet, IntegrationParameters, NarrowPhase,
+    PhysicsWorld as RapierWorld, QueryFilter, QueryPipeline, Ray, RayIntersection, Real,
+    RigidBodySet, Vector,
+};
+
+use crate::collision_groups;
+use crate::error::VehicleError;
+use crate::road_collider::{RoadColliderParams, RoadColliders, build_merge_road};
+
+/// Standard gravity used by the world and by the vehicles' static loads (m/s²).
+pub const GRAVITY_MPS2: f64 = 9.81;
+
+/// Smallest and largest accepted physics step (s).
+pub const DT_RANGE_S: (f64, f64) = (1e-4, 0.02);
+
+/// Thickness of the flat pad (m); its top face is the plane z = 0.
+const FLAT_GROUND_THICKNESS_M: f64 = 1.0;
+
+/// Half extent used by [`PhysicsWorld::add_flat_ground`] when given an unusable value (m).
+pub const FALLBACK_GROUND_HALF_EXTENT_M: f64 = 1000.0;
+
+/// World frame: X along the road, Y left, Z up, gravity (0, 0, −9.81). Rapier works in `f32`;
+/// this wrapper and the vehicles speak `f64` SI.
+pub struct PhysicsWorld {
+    world: RapierWorld,
+    dt_s: f64,
+    steps: u64,
+}
+
+impl PhysicsWorld {
+    /// A world stepping `dt_s` seconds per [`step`](Self::step); `dt_s` must lie in
+    /// [`DT_RANGE_S`].
+    pub fn new(dt_s: f64) -> Result<Self, VehicleError> {
+        if !dt_s.is_finite() || dt_s < DT_RANGE_S.0 || dt_s > DT_RANGE_S.1 {
+            return Err(VehicleError::invalid(
+                "dt_s",
+                dt_s,
+                format!("must lie in [{}, {}] s", DT_RANGE_S.0, DT_RANGE_S.1),
+            ));
+        }
+        let world = RapierWorld {
+            gravity: Vector::new(0.0, 0.0, -GRAVITY_MPS2 as Real),
+            integration_parameters: IntegrationParameters {
+                dt: dt_s as Real,
+                ..IntegrationParameters::default()
+            },
+            ..RapierWorld::default()
+        };
+        Ok(Self {
+            world,
+            dt_s,
+            steps: 0,
+        })
+    }
+
+    /// The physics step (s).
+    pub fn dt_s(&self) -> f64 {
+        self.dt_s
+    }
+
+    /// Magnitude of gravity (m/s²).
+    pub fn gravity_mps2(&self) -> f64 {
+        GRAVITY_MPS2
+    }
+
+    /// Number of steps taken so far.
+    pub fn step_count(&self) -> u64 {
+        self.steps
+    }
+
+    /// Simulated time, `step_count · dt` (s); computed, not accumulated, so it does not drift.
+    pub fn time_s(&self) -> f64 {
+        self.steps as f64 * self.dt_s
+    }
+
+    /// Adds a square flat pad centred on the origin, top face at z = 0 (for maneuvers). A
+    /// non-finite or non-positive size falls back to [`FALLBACK_GROUND_HALF_EXTENT_M`]; use
+    /// [`try_add_flat_ground`](Self::try_add_flat_ground) to get an error instead.
+    pub fn add_flat_ground(&mut self, half_extent_m: f64) {
+        let half = if half_extent_m.is_finite() && half_extent_m > 0.0 {
+            half_extent_m
+        } else {
+            FALLBACK_GROUND_HALF_EXTENT_M
+        };
+        self.insert_flat_ground(half);
+    }
+
+    /// Like [`add_flat_ground`](Self::add_flat_ground) but rejects a bad size and returns the
+    /// pad's collider.
+    pub fn try_add_flat_ground(
+        &mut self,
+        half_extent_m: f64,
+    ) -> Result<ColliderHandle, VehicleError> {
+        if !half_extent_m.is_finite() || half_extent_m <= 0.0 || half_extent_m > 1e6 {
+            return Err(VehicleError::invalid(
+                "half_extent_m",
+                half_extent_m,
+                "must lie in (0, 1e6] m",
+            ));
+        }
+        Ok(self.insert_flat_ground(half_extent_m))
+    }
+
+    fn insert_flat_ground(&mut self, half_extent_m: f64) -> ColliderHandle {
+        let half_z = 0.5 * FLAT_GROUND_THICKNESS_M;
+        let collider =
+            ColliderBuilder::cuboid(half_extent_m as Real, half_extent_m as Real, half_z as Real)
+                .translation(Vector::new(0.0, 0.0, -half_z as Real))
+                .collision_groups(collision_groups::road_surface())
+                .build();
+        let handle = self.world.insert_collider(collider, None);
+        self.refresh_queries();
+        handle
+    }
+
+    /// Adds the merge road: surface plus edge barriers along the upper edge and along each
+    /// piece of the piecewise lower edge (`road.lower_edge_polyline()`), with default
+    /// [`RoadColliderParams`]. Never panics: degenerate pieces are skipped.
+    pub fn add_merge_road(&mut self, road: &planner::MergeRoad) -> RoadColliders {
+        self.add_merge_road_with(road, &RoadColliderParams::default())
+    }
+
+    /// [`add_merge_road`](Self::add_merge_road) with explicit barrier / surface dimensions.
+    pub fn add_merge_road_with(
+        &mut self,
+        road: &planner::MergeRoad,
+        params: &RoadColliderParams,
+    ) -> RoadColliders {
+        let colliders = build_merge_road(&mut self.world, road, params);
+        self.refresh_queries();
+        colliders
+    }
+
+    /// Updates the broad phase so that scene queries (wheel rays, spawn checks) see colliders
+    /// added since the last step.
+    pub(crate) fn refresh_queries(&mut self) {
+        self.world.detect_collisions(&(), &());
+    }
+
+    /// One rapier step of `dt_s`.
+    pub fn step(&mut self) {
+        self.world.step();
+        self.steps += 1;
+    }
+
+    /// The rigid bodies.
+    pub fn bodies(&self) -> &RigidBodySet {
+        &self.world.bodies
+    }
+
+    /// The rigid bodies, mutable (e.g. to add forces of your own).
+    pub fn bodies_mut(&mut self) -> &mut RigidBodySet {
+        &mut self.world.bodies
+    }
+
+    /// The colliders (chassis boxes, road surface, barriers).
+    pub fn colliders(&self) -> &ColliderSet {
+        &self.world.colliders
+    }
+
+    /// The narrow phase (contact pairs of the last step).
+    pub fn narrow_phase(&self) -> &NarrowPhase {
+        &self.world.narrow_phase
+    }
+
+    /// The wrapped rapier world, for anything not exposed here.
+    pub fn rapier(&self) -> &RapierWorld {
+        &self.world
+    }
+
+    /// The wrapped rapier world, mutable. Changing `integration_parameters.dt` desynchronises
+    /// [`dt_s`](Self::dt_s); don't.
+    pub fn rapier_mut(&mut self) -> &mut RapierWorld {
+        &mut self.world
+    }
+
+    /// A scene-query view with the given filter.
+    pub fn query_pipeline<'a>(&'a self, filter: QueryFilter<'a>) -> QueryPipeline<'a> {
+        self.world.query_pipeline_with_filter(filter)
+    }
+
+    /// First road-surface hit of a ray (wheel-ray groups), with its normal.
+    pub(crate) fn cast_road_ray(&self, ray: &Ray, max_toi_m: Real) -> Option<RayIntersection> {
+        let filter = QueryFilter::new().groups(collision_groups::wheel_ray());
+        self.world
+            .query_pipeline_with_filter(filter)
+            .cast_ray_and_get_normal(ray, max_toi_m, true)
+            .map(|(_, hit)| hit)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_bad_dt() {
+        for dt in [0.0, -0.002, f64::NAN, f64::INFINITY, 1.0] {
+            let err = PhysicsWorld::new(dt).err().map(|e| e.to_string());
+            assert!(
+                err.as_deref().is_some_and(|e| e.contains("dt_s")),
+                "{dt}: {err:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn flat_ground_top_face_is_at_zero() {
+        let mut world = PhysicsWorld::new(0.002).unwrap_or_else(|e| panic!("{e}"));
+        world.add_flat_ground(50.0);
+        let ray = Ray::new(Vector::new(3.0, -7.0, 2.0), Vector::new(0.0, 0.0, -1.0));
+        let hit = world.cast_road_ray(&ray, 10.0).map(|h| h.time_of_impact);
+        assert_eq!(hit, Some(2.0));
+    }
+}
