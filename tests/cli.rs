@@ -36,10 +36,20 @@ fn run_writes_json_and_csv_that_follow_the_contract() {
         csv.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     for key in [
-        "scenario", "planner", "seed", "duration_s", "wall_time_s", "collisions", "min_gap_m",
-        "min_ttc_s", "near_miss", "vehicles", "planner_stats",
+        "scenario",
+        "planner",
+        "seed",
+        "duration_s",
+        "wall_time_s",
+        "collisions",
+        "min_gap_m",
+        "min_ttc_s",
+        "near_miss",
+        "vehicles",
+        "planner_stats",
     ] {
         assert!(v.get(key).is_some(), "missing {key} in {v}");
     }
@@ -51,8 +61,14 @@ fn run_writes_json_and_csv_that_follow_the_contract() {
     assert_eq!(ids, ["ego", "obstacle"]);
     for vehicle in vehicles {
         for key in [
-            "max_abs_sideslip_rad", "max_abs_yaw_rad", "max_abs_yaw_rate_radps", "min_speed_mps",
-            "t_min_speed_s", "path_length_m", "yaw_rate_sign_changes", "collided",
+            "max_abs_sideslip_rad",
+            "max_abs_yaw_rad",
+            "max_abs_yaw_rate_radps",
+            "min_speed_mps",
+            "t_min_speed_s",
+            "path_length_m",
+            "yaw_rate_sign_changes",
+            "collided",
         ] {
             assert!(vehicle.get(key).is_some(), "missing vehicles[].{key}");
         }
@@ -61,7 +77,10 @@ fn run_writes_json_and_csv_that_follow_the_contract() {
         assert!(length > 150.0 && length < 600.0, "{length}");
     }
     for key in ["plans", "fallbacks", "p50_plan_us", "p99_plan_us"] {
-        assert!(v["planner_stats"].get(key).is_some(), "missing planner_stats.{key}");
+        assert!(
+            v["planner_stats"].get(key).is_some(),
+            "missing planner_stats.{key}"
+        );
     }
     // Two vehicles planning at 10 Hz for 25 s.
     assert_eq!(v["planner_stats"]["plans"].as_u64().unwrap(), 2 * 250);
@@ -77,7 +96,11 @@ fn run_writes_json_and_csv_that_follow_the_contract() {
     // Both vehicles at every logged instant (20 Hz × 25 s).
     assert_eq!(rows.len(), 2 * 500);
     assert!(rows.iter().all(|r| r[1] == "ego" || r[1] == "obstacle"));
-    assert!(rows.iter().all(|r| r.iter().skip(2).all(|x| x.parse::<f64>().unwrap().is_finite())));
+    assert!(rows.iter().all(|r| {
+        r.iter()
+            .skip(2)
+            .all(|x| x.parse::<f64>().unwrap().is_finite())
+    }));
 }
 
 #[test]
@@ -100,7 +123,11 @@ fn recording_is_written_and_verifies_with_the_rerun_cli() {
         .arg(&rrd)
         .output()
         .expect("the Rerun CLI (pip install rerun-sdk==0.36.3, done by .ci/run) is on PATH");
-    assert!(verify.status.success(), "rerun rrd verify: {}", stderr(&verify));
+    assert!(
+        verify.status.success(),
+        "rerun rrd verify: {}",
+        stderr(&verify)
+    );
 }
 
 #[test]
@@ -108,13 +135,54 @@ fn bad_input_exits_2_naming_the_value_and_writes_nothing() {
     let dir = scratch("bad");
     let json = dir.join("out.json");
     let cases: Vec<(Vec<String>, &str)> = vec![
-        (vec!["run".into(), "--scenario".into(), "nowhere".into()], "nowhere"),
-        (vec!["run".into(), "--planner".into(), "pf-xyz".into()], "pf-xyz"),
-        (vec!["maneuver".into(), "braking".into(), "--vehicle".into(), "tesla".into()], "tesla"),
-        (vec!["maneuver".into(), "braking".into(), "--mu".into(), "0".into()], "mu"),
-        (vec!["maneuver".into(), "braking".into(), "--mu".into(), "-0.3".into()], "-0.3"),
-        (vec!["maneuver".into(), "braking".into(), "--speed-mps".into(), "NaN".into()], "NaN"),
-        (vec!["run".into(), "--json".into(), "/no/such/dir/x.json".into()], "/no/such/dir"),
+        (
+            vec!["run".into(), "--scenario".into(), "nowhere".into()],
+            "nowhere",
+        ),
+        (
+            vec!["run".into(), "--planner".into(), "pf-xyz".into()],
+            "pf-xyz",
+        ),
+        (
+            vec![
+                "maneuver".into(),
+                "braking".into(),
+                "--vehicle".into(),
+                "tesla".into(),
+            ],
+            "tesla",
+        ),
+        (
+            vec![
+                "maneuver".into(),
+                "braking".into(),
+                "--mu".into(),
+                "0".into(),
+            ],
+            "mu",
+        ),
+        (
+            vec![
+                "maneuver".into(),
+                "braking".into(),
+                "--mu".into(),
+                "-0.3".into(),
+            ],
+            "-0.3",
+        ),
+        (
+            vec![
+                "maneuver".into(),
+                "braking".into(),
+                "--speed-mps".into(),
+                "NaN".into(),
+            ],
+            "NaN",
+        ),
+        (
+            vec!["run".into(), "--json".into(), "/no/such/dir/x.json".into()],
+            "/no/such/dir",
+        ),
     ];
     for (mut args, needle) in cases {
         if !args.iter().any(|a| a == "--json") {
@@ -143,7 +211,11 @@ fn bad_scenario_file_names_the_field() {
     std::fs::write(&path, text).unwrap();
     let out = merge_sim(&["run", "--no-rrd", "--scenario", path.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("mu") && stderr(&out).contains("7.5"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("mu") && stderr(&out).contains("7.5"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]
@@ -165,19 +237,37 @@ fn maneuver_json_has_the_documented_keys() {
     let dir = scratch("maneuver");
     let json = dir.join("m.json");
     let out = merge_sim(&[
-        "maneuver", "steady-state", "--speed-mps", "15", "--steer-rad", "0.01", "--json",
+        "maneuver",
+        "steady-state",
+        "--speed-mps",
+        "15",
+        "--steer-rad",
+        "0.01",
+        "--json",
         json.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     for key in [
-        "maneuver", "vehicle", "speed_mps", "steer_rad", "mu", "yaw_rate_radps", "sideslip_rad",
-        "lat_accel_mps2", "params",
+        "maneuver",
+        "vehicle",
+        "speed_mps",
+        "steer_rad",
+        "mu",
+        "yaw_rate_radps",
+        "sideslip_rad",
+        "lat_accel_mps2",
+        "params",
     ] {
         assert!(v.get(key).is_some(), "missing {key}: {v}");
     }
     for key in [
-        "mass_kg", "yaw_inertia_kgm2", "lf_m", "lr_m", "cornering_stiffness_front_npr",
+        "mass_kg",
+        "yaw_inertia_kgm2",
+        "lf_m",
+        "lr_m",
+        "cornering_stiffness_front_npr",
         "cornering_stiffness_rear_npr",
     ] {
         assert!(v["params"].get(key).is_some(), "missing params.{key}");
@@ -191,5 +281,8 @@ fn maneuver_json_has_the_documented_keys() {
     let b: serde_json::Value = serde_json::from_slice(&braking.stdout).unwrap();
     let d = b["stopping_distance_m"].as_f64().unwrap();
     let reference = 20.0f64.powi(2) / (2.0 * 0.8 * 9.81);
-    assert!(d > 0.95 * reference && d < 1.3 * reference, "{d} vs {reference}");
+    assert!(
+        d > 0.95 * reference && d < 1.3 * reference,
+        "{d} vs {reference}"
+    );
 }

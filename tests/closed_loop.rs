@@ -11,16 +11,26 @@ fn run(scenario: &Scenario, planner: Option<PlannerKind>, keep_time_series: bool
         seed: 0,
         keep_time_series,
     };
-    World::new(scenario.sim.clone(), &scenario.vehicles, &options, Recorder::disabled())
-        .unwrap()
-        .run(|_| {})
-        .unwrap()
+    World::new(
+        scenario.sim.clone(),
+        &scenario.vehicles,
+        &options,
+        Recorder::disabled(),
+    )
+    .unwrap()
+    .run(|_| {})
+    .unwrap()
 }
 
 #[test]
 fn every_planner_completes_the_urgent_merge_without_collision() {
     let scenario = Scenario::load("urgent_merge").unwrap();
-    for kind in [PlannerKind::PfCs, PlannerKind::PfSp, PlannerKind::PfIso, PlannerKind::PfIsoPred] {
+    for kind in [
+        PlannerKind::PfCs,
+        PlannerKind::PfSp,
+        PlannerKind::PfIso,
+        PlannerKind::PfIsoPred,
+    ] {
         let outcome = run(&scenario, Some(kind), true);
         assert!(
             outcome.safety.collisions.is_empty(),
@@ -30,9 +40,19 @@ fn every_planner_completes_the_urgent_merge_without_collision() {
         );
         assert!((outcome.duration_s - 25.0).abs() < 1e-9);
         // The ego has merged: at the end it is in the through lane, past the merge section.
-        let last_ego = outcome.time_series.iter().rev().find(|r| r.vehicle == "ego").unwrap();
+        let last_ego = outcome
+            .time_series
+            .iter()
+            .rev()
+            .find(|r| r.vehicle == "ego")
+            .unwrap();
         let road = &scenario.sim.road;
-        assert!(last_ego.x_m > road.merge_end_x_m, "{}: ego at x = {}", kind.name(), last_ego.x_m);
+        assert!(
+            last_ego.x_m > road.merge_end_x_m,
+            "{}: ego at x = {}",
+            kind.name(),
+            last_ego.x_m
+        );
         assert!(
             last_ego.y_m > road.y_lane_m() && last_ego.y_m < road.y_upper_m(),
             "{}: ego at y = {}",
@@ -48,14 +68,20 @@ fn unsafe_rear_end_is_reported_by_parry_at_the_right_time() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/rear_end.toml");
     let scenario = Scenario::load(path).unwrap();
     let outcome = run(&scenario, None, false);
-    assert_eq!(outcome.safety.collisions.len(), 1, "{:?}", outcome.safety.collisions);
+    // The rear car keeps driving into the front one after the first impact, so contact
+    // episodes may repeat; the first one must come at the analytic time.
+    assert!(!outcome.safety.collisions.is_empty());
     let event = &outcome.safety.collisions[0];
+    assert_eq!((event.id_a, event.id_b), (0, 1));
     // Gap 25.492 m closing at 10 m/s: contact at 2.549 s if both hold their speeds.
     assert!(
-        (event.t_s - 2.549).abs() < 0.1,
-        "collision at {} s, expected 2.549 s",
+        (event.t_s - 2.549).abs() <= 0.011,
+        "collision detected at {} s, expected 2.549 s (+ one 10 ms check period)",
         event.t_s
     );
+    // Interpolated from the TTC at the previous check.
+    let estimate = event.t_contact_estimate_s.unwrap();
+    assert!((estimate - 2.549).abs() < 0.005, "{estimate}");
     assert!(outcome.vehicles.iter().all(|v| v.collided));
     assert!(!outcome.safety.near_miss, "a collision is not a near miss");
 }
@@ -69,8 +95,16 @@ fn same_scenario_and_seed_give_bitwise_identical_runs() {
     for (ra, rb) in a.time_series.iter().zip(&b.time_series) {
         let bits = |r: &mergesim::sim::TimeSeriesRow| {
             [
-                r.t_s, r.x_m, r.y_m, r.yaw_rad, r.yaw_rate_radps, r.sideslip_rad, r.speed_mps,
-                r.planned_speed_mps, r.accel_long_mps2, r.accel_lat_mps2,
+                r.t_s,
+                r.x_m,
+                r.y_m,
+                r.yaw_rad,
+                r.yaw_rate_radps,
+                r.sideslip_rad,
+                r.speed_mps,
+                r.planned_speed_mps,
+                r.accel_long_mps2,
+                r.accel_lat_mps2,
             ]
             .map(f64::to_bits)
         };

@@ -73,18 +73,32 @@ fn plan_cycle(c: &mut Criterion) {
     c.bench_function("pf_iso_plan_cycle_n20_one_neighbour", |b| {
         b.iter(|| planner.plan(black_box(&request)))
     });
-    let mut fresh = PfPlanner::new(PlannerKind::PfIso, planner.params().clone(), planner.road().clone())
-        .expect("valid");
+    let mut fresh = PfPlanner::new(
+        PlannerKind::PfIso,
+        planner.params().clone(),
+        planner.road().clone(),
+    )
+    .expect("valid");
     c.bench_function("pf_iso_plan_cycle_cold_solver", |b| {
         b.iter(|| {
-            fresh = PfPlanner::new(PlannerKind::PfIso, planner.params().clone(), planner.road().clone())
-                .expect("valid");
+            fresh = PfPlanner::new(
+                PlannerKind::PfIso,
+                planner.params().clone(),
+                planner.road().clone(),
+            )
+            .expect("valid");
             fresh.plan(black_box(&request))
         })
     });
-    let mut sp = PfPlanner::new(PlannerKind::PfSp, planner.params().clone(), planner.road().clone())
-        .expect("valid");
-    c.bench_function("pf_sp_plan_cycle_n20", |b| b.iter(|| sp.plan(black_box(&request))));
+    let mut sp = PfPlanner::new(
+        PlannerKind::PfSp,
+        planner.params().clone(),
+        planner.road().clone(),
+    )
+    .expect("valid");
+    c.bench_function("pf_sp_plan_cycle_n20", |b| {
+        b.iter(|| sp.plan(black_box(&request)))
+    });
 }
 
 criterion_group!(benches, plan_cycle);

@@ -27,9 +27,7 @@
 //! Cholesky solve) already satisfies the bounds it *is* the QP optimum and Clarabel is skipped.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettings, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus,
-};
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
 use nalgebra::{Matrix4, Vector4};
 
 use crate::error::PlannerError;
@@ -100,7 +98,11 @@ pub fn solve_box_qp(
     tolerance: f64,
 ) -> Result<[f64; 4], PlannerError> {
     let finite = m.iter().chain(r.iter()).all(|v| v.is_finite())
-        && bounds.lower.iter().chain(&bounds.upper).all(|v| v.is_finite());
+        && bounds
+            .lower
+            .iter()
+            .chain(&bounds.upper)
+            .all(|v| v.is_finite());
     if !finite {
         return Err(PlannerError::NonFinite {
             what: "cubic_fit QP data".into(),
@@ -284,7 +286,8 @@ pub fn fit_path_cubic(
     }
     let mut previous_xi = 0.0;
     for p in &local {
-        if !(p[0] > previous_xi + 1e-6) {
+        // (finite: checked above)
+        if p[0] <= previous_xi + 1e-6 {
             return Err(PlannerError::SolverFailed {
                 problem: "cubic_fit".into(),
                 status: "waypoints do not advance along the vehicle heading".into(),
@@ -411,8 +414,8 @@ mod tests {
         let (path, xis) = fit_path_cubic(&params, origin, yaw, &waypoints).unwrap();
         assert_eq!(xis.len(), 20);
         assert!((path.x_scale_m - s).abs() < 1e-9);
-        for k in 0..4 {
-            assert!((path.coefficients[k] - truth[k]).abs() < 1e-8);
+        for (a, t) in path.coefficients.iter().zip(truth) {
+            assert!((a - t).abs() < 1e-8, "{:?}", path.coefficients);
         }
         for (p, xi) in waypoints.iter().zip(&xis) {
             let q = path.world_point(*xi);

@@ -86,7 +86,10 @@ mod tests {
         let centre = road.lane_center_y_m(crate::road::Lane::Lower);
         let first_offset = (2.4 - centre).abs();
         let last_offset = (path[19][1] - centre).abs();
-        assert!(last_offset < 0.3 * first_offset, "{last_offset} vs {first_offset}");
+        assert!(
+            last_offset < 0.3 * first_offset,
+            "{last_offset} vs {first_offset}"
+        );
         // Monotone along X (the pull dominates).
         assert!(path.windows(2).all(|w| w[1][0] > w[0][0]));
     }

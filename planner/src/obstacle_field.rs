@@ -200,7 +200,13 @@ mod tests {
         );
         assert!(field.sigma_front_m != field.sigma_rear_m);
         let h = 1e-6;
-        for (x, y) in [(25.0, 4.0), (36.0, 6.5), (30.5, 3.0), (10.0, 5.0), (45.0, 9.0)] {
+        for (x, y) in [
+            (25.0, 4.0),
+            (36.0, 6.5),
+            (30.5, 3.0),
+            (10.0, 5.0),
+            (45.0, 9.0),
+        ] {
             let g = field.gradient(x, y);
             let fx = (field.value(x + h, y) - field.value(x - h, y)) / (2.0 * h);
             let fy = (field.value(x, y + h) - field.value(x, y - h)) / (2.0 * h);

@@ -210,8 +210,7 @@ pub fn validate_request(req: &PlanRequest<'_>) -> Result<(), PlannerError> {
             return Err(non_finite(&what));
         }
         check_shape(&m.shape, &format!("{what}.shape"))?;
-        if m
-            .waypoints
+        if m.waypoints
             .iter()
             .any(|w| !(w.t_s.is_finite() && w.x_m.is_finite() && w.y_m.is_finite()))
         {
@@ -235,7 +234,11 @@ struct CycleFailure {
 
 impl PfPlanner {
     /// A planner of `kind`; fails if the parameters or the road are invalid.
-    pub fn new(kind: PlannerKind, params: PlannerParams, road: MergeRoad) -> Result<Self, PlannerError> {
+    pub fn new(
+        kind: PlannerKind,
+        params: PlannerParams,
+        road: MergeRoad,
+    ) -> Result<Self, PlannerError> {
         params.validate()?;
         road.validate()?;
         Ok(Self {
@@ -338,7 +341,10 @@ impl PfPlanner {
     }
 
     /// The others' motion for the interaction term, by id: (trajectory, speed, shape).
-    fn others(&self, req: &PlanRequest<'_>) -> BTreeMap<VehicleId, (Trajectory, f64, VehicleShape)> {
+    fn others(
+        &self,
+        req: &PlanRequest<'_>,
+    ) -> BTreeMap<VehicleId, (Trajectory, f64, VehicleShape)> {
         let mut others = BTreeMap::new();
         if self.kind == PlannerKind::PfIso {
             // The newest fresh SLP of each sender.
@@ -417,8 +423,13 @@ impl PfPlanner {
         }
 
         // Eqs. 8–9: cubic in the vehicle frame.
-        let (cubic, xis) = fit_path_cubic(params, [req.ego.x_m, req.ego.y_m], req.ego.yaw_rad, &waypoints)
-            .map_err(|e| fail(e, Some(waypoints.clone())))?;
+        let (cubic, xis) = fit_path_cubic(
+            params,
+            [req.ego.x_m, req.ego.y_m],
+            req.ego.yaw_rad,
+            &waypoints,
+        )
+        .map_err(|e| fail(e, Some(waypoints.clone())))?;
         self.stats.cubic_qp = cubic.method == FitMethod::Qp;
         let points: Vec<[f64; 2]> = xis.iter().map(|xi| cubic.world_point(*xi)).collect();
         if points.iter().flatten().any(|v| !v.is_finite()) {
@@ -430,7 +441,8 @@ impl PfPlanner {
         // Eq. 10: speeds.
         let speeds_mps = match self.kind {
             PlannerKind::PfCs => vec![
-                req.target_speed_mps.clamp(params.min_speed_mps, params.speed_limit_mps);
+                req.target_speed_mps
+                    .clamp(params.min_speed_mps, params.speed_limit_mps);
                 n
             ],
             PlannerKind::PfSp | PlannerKind::PfIso | PlannerKind::PfIsoPred => {
@@ -453,7 +465,10 @@ impl PfPlanner {
                         let bases: Vec<(ObstacleField, &Trajectory)> = others
                             .values()
                             .map(|(trajectory, speed, shape)| {
-                                (ObstacleField::new(params, me, 0.0, 0.0, 0.0, *speed, shape), trajectory)
+                                (
+                                    ObstacleField::new(params, me, 0.0, 0.0, 0.0, *speed, shape),
+                                    trajectory,
+                                )
                             })
                             .collect();
                         let fields = (1..=n)
@@ -463,7 +478,12 @@ impl PfPlanner {
                                     .iter()
                                     .map(|(base, trajectory)| {
                                         let pose = trajectory.pose_at(t_s);
-                                        base.moved_to(pose.xy_m[0], pose.xy_m[1], pose.heading[0], pose.heading[1])
+                                        base.moved_to(
+                                            pose.xy_m[0],
+                                            pose.xy_m[1],
+                                            pose.heading[0],
+                                            pose.heading[1],
+                                        )
                                     })
                                     .collect()
                             })
@@ -481,7 +501,12 @@ impl PfPlanner {
                 // Warm start: the last good plan's speeds at the same absolute times.
                 let guess: Option<Vec<f64>> = self.last_good.as_ref().and_then(|last| {
                     (1..=n)
-                        .map(|i| speed_at_time(&last.path, req.time_s + (i as f64 - 0.5) * params.step_time_s))
+                        .map(|i| {
+                            speed_at_time(
+                                &last.path,
+                                req.time_s + (i as f64 - 0.5) * params.step_time_s,
+                            )
+                        })
                         .collect()
                 });
                 let problem = SpeedProblem {
@@ -519,10 +544,12 @@ impl PfPlanner {
                 t_s,
             });
         }
-        if path
-            .iter()
-            .any(|p| !(p.x_m.is_finite() && p.y_m.is_finite() && p.speed_mps.is_finite() && p.t_s.is_finite()))
-        {
+        if path.iter().any(|p| {
+            !(p.x_m.is_finite()
+                && p.y_m.is_finite()
+                && p.speed_mps.is_finite()
+                && p.t_s.is_finite())
+        }) {
             return Err(fail(non_finite("planned path"), Some(waypoints)));
         }
         let shared = SharedLocalPath {

@@ -74,7 +74,10 @@ impl Polyline {
         let b = self.points[j + 1];
         let tangent = [(b[0] - a[0]) / length, (b[1] - a[1]) / length];
         let along = s_m - self.arc_m[j];
-        ([a[0] + along * tangent[0], a[1] + along * tangent[1]], tangent)
+        (
+            [a[0] + along * tangent[0], a[1] + along * tangent[1]],
+            tangent,
+        )
     }
 }
 
@@ -99,6 +102,9 @@ mod tests {
     #[test]
     fn single_point_uses_the_fallback_tangent() {
         let line = Polyline::new(vec![[1.0, 2.0]]).unwrap();
-        assert_eq!(line.point_and_tangent(5.0, [0.0, 1.0]), ([1.0, 2.0], [0.0, 1.0]));
+        assert_eq!(
+            line.point_and_tangent(5.0, [0.0, 1.0]),
+            ([1.0, 2.0], [0.0, 1.0])
+        );
     }
 }

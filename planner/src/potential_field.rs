@@ -191,7 +191,11 @@ impl<'a> PotentialField<'a> {
     }
 
     /// Samples U (with or without the attraction) on a grid, row after row.
-    pub fn grid(&self, spec: &GridSpec, include_attractive: bool) -> Result<Vec<f64>, PlannerError> {
+    pub fn grid(
+        &self,
+        spec: &GridSpec,
+        include_attractive: bool,
+    ) -> Result<Vec<f64>, PlannerError> {
         spec.validate()?;
         let mut values = Vec::with_capacity(spec.columns * spec.rows);
         for row in 0..spec.rows {
@@ -239,15 +243,36 @@ mod tests {
             },
         ];
         let ego = state(20.0, 1.75, 0.0, 20.0);
-        let field = PotentialField::new(&params, &road, 0, &ego, &VehicleShape::default(), &neighbours);
+        let field = PotentialField::new(
+            &params,
+            &road,
+            0,
+            &ego,
+            &VehicleShape::default(),
+            &neighbours,
+        );
         assert_eq!(field.obstacles.len(), 2);
         let h = 1e-6;
-        for (x, y) in [(25.0, 2.0), (38.0, 3.5), (45.0, 4.9), (12.0, 2.6), (180.0, 2.5)] {
+        for (x, y) in [
+            (25.0, 2.0),
+            (38.0, 3.5),
+            (45.0, 4.9),
+            (12.0, 2.6),
+            (180.0, 2.5),
+        ] {
             let g = field.gradient(x, y);
             let fx = (field.value(x + h, y) - field.value(x - h, y)) / (2.0 * h);
             let fy = (field.value(x, y + h) - field.value(x, y - h)) / (2.0 * h);
-            assert!((g[0] - fx).abs() < 1e-6 * (1.0 + fx.abs()), "({x},{y}) x: {} vs {fx}", g[0]);
-            assert!((g[1] - fy).abs() < 1e-6 * (1.0 + fy.abs()), "({x},{y}) y: {} vs {fy}", g[1]);
+            assert!(
+                (g[0] - fx).abs() < 1e-6 * (1.0 + fx.abs()),
+                "({x},{y}) x: {} vs {fx}",
+                g[0]
+            );
+            assert!(
+                (g[1] - fy).abs() < 1e-6 * (1.0 + fy.abs()),
+                "({x},{y}) y: {} vs {fy}",
+                g[1]
+            );
         }
     }
 
@@ -261,7 +286,14 @@ mod tests {
             state: ego,
             shape: VehicleShape::default(),
         }];
-        let field = PotentialField::new(&params, &road, 7, &ego, &VehicleShape::default(), &neighbours);
+        let field = PotentialField::new(
+            &params,
+            &road,
+            7,
+            &ego,
+            &VehicleShape::default(),
+            &neighbours,
+        );
         assert!(field.obstacles.is_empty());
     }
 
@@ -282,7 +314,10 @@ mod tests {
         assert_eq!(values.len(), 21);
         // Row 2, column 5 is at (−10 + 5.5·0.5, 0 + 2.5·0.5).
         assert_eq!(values[2 * 7 + 5], field.value(-7.25, 1.25));
-        let bad = GridSpec { cell_m: 0.0, ..spec };
+        let bad = GridSpec {
+            cell_m: 0.0,
+            ..spec
+        };
         assert!(field.grid(&bad, true).is_err());
     }
 }

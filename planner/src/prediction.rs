@@ -115,10 +115,26 @@ mod tests {
             shape: VehicleShape::default(),
             speed_mps: 10.0,
             waypoints: vec![
-                TimedWaypoint { t_s: 10.0, x_m: 0.0, y_m: 0.0 },
-                TimedWaypoint { t_s: 11.0, x_m: 10.0, y_m: 0.0 },
-                TimedWaypoint { t_s: 11.0, x_m: 99.0, y_m: 99.0 }, // not later: dropped
-                TimedWaypoint { t_s: 12.0, x_m: 20.0, y_m: 5.0 },
+                TimedWaypoint {
+                    t_s: 10.0,
+                    x_m: 0.0,
+                    y_m: 0.0,
+                },
+                TimedWaypoint {
+                    t_s: 11.0,
+                    x_m: 10.0,
+                    y_m: 0.0,
+                },
+                TimedWaypoint {
+                    t_s: 11.0,
+                    x_m: 99.0,
+                    y_m: 99.0,
+                }, // not later: dropped
+                TimedWaypoint {
+                    t_s: 12.0,
+                    x_m: 20.0,
+                    y_m: 5.0,
+                },
             ],
         };
         let trajectory = Trajectory::from_shared(&message, 0.0).unwrap();

@@ -87,14 +87,14 @@ impl MergeRoad {
                 reason: "must lie in [2, 6] m".into(),
             });
         }
-        if !(self.start_x_m < self.merge_start_x_m) {
+        if self.start_x_m >= self.merge_start_x_m {
             return Err(PlannerError::InvalidParameter {
                 name: "road.merge_start_x_m".into(),
                 value: self.merge_start_x_m,
                 reason: format!("must be greater than road.start_x_m = {}", self.start_x_m),
             });
         }
-        if !(self.merge_end_x_m > self.merge_start_x_m) {
+        if self.merge_end_x_m <= self.merge_start_x_m {
             return Err(PlannerError::InvalidParameter {
                 name: "road.merge_end_x_m".into(),
                 value: self.merge_end_x_m,
@@ -104,7 +104,7 @@ impl MergeRoad {
                 ),
             });
         }
-        if !(self.end_x_m > self.merge_end_x_m) {
+        if self.end_x_m <= self.merge_end_x_m {
             return Err(PlannerError::InvalidParameter {
                 name: "road.end_x_m".into(),
                 value: self.end_x_m,
@@ -195,9 +195,14 @@ mod tests {
         let road = MergeRoad::default();
         assert_eq!(road.lower_edge_y_m(0.0), road.y_bottom_m);
         assert!((road.lower_edge_y_m(road.merge_end_x_m) - road.y_lane_m()).abs() < 1e-12);
-        assert_eq!(road.lower_edge_y_m(road.merge_end_x_m + 10.0), road.y_lane_m());
+        assert_eq!(
+            road.lower_edge_y_m(road.merge_end_x_m + 10.0),
+            road.y_lane_m()
+        );
         let mid = 0.5 * (road.merge_start_x_m + road.merge_end_x_m);
-        assert!((road.lower_edge_y_m(mid) - (road.y_bottom_m + 0.5 * road.lane_width_m)).abs() < 1e-12);
+        assert!(
+            (road.lower_edge_y_m(mid) - (road.y_bottom_m + 0.5 * road.lane_width_m)).abs() < 1e-12
+        );
     }
 
     #[test]

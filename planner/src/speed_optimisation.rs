@@ -321,11 +321,7 @@ fn solver_failed(status: impl Into<String>) -> PlannerError {
 }
 
 /// J(v) of Eq. 10 (module doc), with the interaction term if given.
-pub fn objective(
-    params: &PlannerParams,
-    problem: &SpeedProblem<'_>,
-    speeds_mps: &[f64],
-) -> f64 {
+pub fn objective(params: &PlannerParams, problem: &SpeedProblem<'_>, speeds_mps: &[f64]) -> f64 {
     let mut j = 0.0;
     for (v, ds) in speeds_mps.iter().zip(problem.segment_lengths_m) {
         let dv = v - problem.target_speed_mps;
@@ -407,10 +403,7 @@ impl SpeedOptimiser {
                 reason: format!("need one time slot per segment ({n})"),
             });
         }
-        let scalars = [
-            problem.current_speed_mps,
-            problem.target_speed_mps,
-        ];
+        let scalars = [problem.current_speed_mps, problem.target_speed_mps];
         if scalars
             .iter()
             .chain(problem.segment_lengths_m)
@@ -462,7 +455,7 @@ impl SpeedOptimiser {
         };
 
         // Without interaction the problem is convex: one exact solve.
-        let Some(_) = interaction else {
+        if interaction.is_none() {
             let zero = vec![0.0; n];
             let mut solves = 1;
             let v = match self.solve_convex(
@@ -473,7 +466,9 @@ impl SpeedOptimiser {
                     // E.g. jerk rows the anchored chain cannot meet: retry unanchored.
                     solves += 1;
                     anchored = false;
-                    self.solve_convex(params, layout, problem, &zero, &lo, &hi, accel_step, jerk_step)?
+                    self.solve_convex(
+                        params, layout, problem, &zero, &lo, &hi, accel_step, jerk_step,
+                    )?
                 }
                 Err(e) => return Err(e),
             };
@@ -489,7 +484,7 @@ impl SpeedOptimiser {
                 solves,
                 anchored,
             });
-        };
+        }
 
         // SCP from a feasible start: the guess (previous plan shifted in time, or V_target)
         // projected onto the box and acceleration chain. With jerk rows the projection is not
@@ -498,7 +493,11 @@ impl SpeedOptimiser {
             Some(g) if g.len() == n && g.iter().all(|v| v.is_finite()) => g.to_vec(),
             _ => vec![problem.target_speed_mps; n],
         };
-        let chain_step = if layout.accel { accel_step } else { f64::INFINITY };
+        let chain_step = if layout.accel {
+            accel_step
+        } else {
+            f64::INFINITY
+        };
         let mut v = project_onto_chain(&raw_guess, &base_lo, &base_hi, chain_step);
         let mut j = objective(params, problem, &v);
         let mut trust_first = !layout.jerk && j.is_finite();
@@ -509,8 +508,16 @@ impl SpeedOptimiser {
             let g = gradient_at(&v);
             let (lo_k, hi_k): (Vec<f64>, Vec<f64>) = if iteration > 0 || trust_first {
                 (
-                    base_lo.iter().zip(&v).map(|(l, vi)| l.max(vi - rho)).collect(),
-                    base_hi.iter().zip(&v).map(|(h, vi)| h.min(vi + rho)).collect(),
+                    base_lo
+                        .iter()
+                        .zip(&v)
+                        .map(|(l, vi)| l.max(vi - rho))
+                        .collect(),
+                    base_hi
+                        .iter()
+                        .zip(&v)
+                        .map(|(h, vi)| h.min(vi + rho))
+                        .collect(),
                 )
             } else {
                 (base_lo.clone(), base_hi.clone())
@@ -603,9 +610,10 @@ impl SpeedOptimiser {
                 && c.tolerance_bits == tolerance_bits
         });
         let updated = reusable
-            && self.cached.as_mut().is_some_and(|c| {
-                c.solver.update_q(&q).is_ok() && c.solver.update_b(&b).is_ok()
-            });
+            && self
+                .cached
+                .as_mut()
+                .is_some_and(|c| c.solver.update_q(&q).is_ok() && c.solver.update_b(&b).is_ok());
         if !updated {
             let settings = DefaultSettings {
                 verbose: false,
@@ -653,7 +661,9 @@ impl SpeedOptimiser {
             });
         }
         // Snap interior-point round-off onto the box.
-        Ok((0..n).map(|i| x[i].clamp(lo[i], hi[i].max(lo[i]))).collect())
+        Ok((0..n)
+            .map(|i| x[i].clamp(lo[i], hi[i].max(lo[i])))
+            .collect())
     }
 }
 
@@ -750,7 +760,10 @@ mod tests {
                 solution.speeds_mps[i]
             );
         }
-        assert!(solution.speeds_mps[0] > 15.3, "travel time pushes above V_target");
+        assert!(
+            solution.speeds_mps[0] > 15.3,
+            "travel time pushes above V_target"
+        );
         // The cached solver gives the same answer on a re-solve.
         let again = optimiser.solve(&params, &problem).unwrap();
         for (a, b) in again.speeds_mps.iter().zip(&solution.speeds_mps) {
@@ -779,6 +792,54 @@ mod tests {
         for w in solution.speeds_mps.windows(2) {
             assert!(w[1] - w[0] <= step + 1e-6);
         }
+    }
+
+    #[test]
+    fn jerk_bounds_hold_on_a_speed_step() {
+        let params = PlannerParams {
+            jerk_bound_enabled: true,
+            max_jerk_mps3: 4.0,
+            ..PlannerParams::default()
+        };
+        let n = 16;
+        let segment_lengths_m = vec![4.0; n];
+        let mut max_speeds_mps = vec![30.0; n];
+        for v in &mut max_speeds_mps[8..] {
+            *v = 12.0; // a bend ahead
+        }
+        let problem = SpeedProblem {
+            current_speed_mps: 16.0,
+            target_speed_mps: 16.0,
+            segment_lengths_m: &segment_lengths_m,
+            max_speeds_mps: &max_speeds_mps,
+            initial_guess_mps: None,
+            interaction: None,
+        };
+        let solution = SpeedOptimiser::new().solve(&params, &problem).unwrap();
+        let dt = params.step_time_s;
+        let jerk_step = params.max_jerk_mps3 * dt * dt;
+        let accel_step = params.max_accel_mps2 * dt;
+        let v = &solution.speeds_mps;
+        for w in v.windows(3) {
+            assert!(
+                (w[2] - 2.0 * w[1] + w[0]).abs() <= jerk_step + 1e-6,
+                "{v:?}"
+            );
+        }
+        for w in v.windows(2) {
+            assert!((w[1] - w[0]).abs() <= accel_step + 1e-6, "{v:?}");
+        }
+        assert!(v[8..].iter().all(|x| *x <= 12.0 + 1e-6), "{v:?}");
+        // The bound binds: without it the profile has a sharper corner.
+        let free = SpeedOptimiser::new()
+            .solve(&PlannerParams::default(), &problem)
+            .unwrap();
+        let max_second_difference = free
+            .speeds_mps
+            .windows(3)
+            .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
+            .fold(0.0, f64::max);
+        assert!(max_second_difference > jerk_step + 1e-3);
     }
 
     #[test]
@@ -838,7 +899,12 @@ mod tests {
                 vec![base.moved_to(-4.0 + 20.0 * t, 2.5 + 0.8 * t, heading.cos(), heading.sin())]
             })
             .collect();
-        let path = Polyline::new((0..=n).map(|k| [k as f64 * 3.75, 5.25 + 0.01 * k as f64]).collect()).unwrap();
+        let path = Polyline::new(
+            (0..=n)
+                .map(|k| [k as f64 * 3.75, 5.25 + 0.01 * k as f64])
+                .collect(),
+        )
+        .unwrap();
         let term = InteractionTerm::new(path, [1.0, 0.0], dt, params.interaction_floor, fields);
         let v: Vec<f64> = (0..n).map(|i| 14.0 + 0.1 * i as f64).collect();
         let (_, g) = term.value_and_gradient(&v);
@@ -849,9 +915,16 @@ mod tests {
             let mut down = v.clone();
             down[j] -= h;
             let fd = (term.value(&up) - term.value(&down)) / (2.0 * h);
-            assert!((g[j] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "j = {j}: {} vs {fd}", g[j]);
+            assert!(
+                (g[j] - fd).abs() < 1e-6 * (1.0 + fd.abs()),
+                "j = {j}: {} vs {fd}",
+                g[j]
+            );
         }
-        assert!(g.iter().any(|gi| gi.abs() > 1e-3), "the term must act: {g:?}");
+        assert!(
+            g.iter().any(|gi| gi.abs() > 1e-3),
+            "the term must act: {g:?}"
+        );
     }
 
     #[test]

@@ -35,6 +35,14 @@ fn planner(kind: PlannerKind) -> PfPlanner {
     PfPlanner::new(kind, PlannerParams::default(), MergeRoad::default()).unwrap()
 }
 
+/// The simulator may run vehicles or Monte-Carlo runs on other threads.
+#[test]
+fn planner_is_send_and_sync() {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<PfPlanner>();
+    assert_send_sync::<Plan>();
+}
+
 #[test]
 fn kind_names_round_trip_and_an_unknown_name_lists_the_valid_ones() {
     for kind in PlannerKind::ALL {
@@ -57,7 +65,10 @@ fn plan_starts_at_the_vehicle_with_times_from_distance_over_speed() {
     let n = p.params().waypoint_count;
     assert_eq!(plan.waypoints.len(), n);
     assert_eq!(plan.path.len(), n + 1);
-    assert_eq!((plan.path[0].x_m, plan.path[0].y_m, plan.path[0].t_s), (20.0, 1.9, 3.0));
+    assert_eq!(
+        (plan.path[0].x_m, plan.path[0].y_m, plan.path[0].t_s),
+        (20.0, 1.9, 3.0)
+    );
     for w in plan.path.windows(2) {
         let ds = ((w[1].x_m - w[0].x_m).powi(2) + (w[1].y_m - w[0].y_m).powi(2)).sqrt();
         // Segment k is driven at the speed held from its first point.
@@ -90,7 +101,10 @@ fn planning_is_deterministic() {
     let b = planner(PlannerKind::PfIsoPred)
         .plan(&request(ego, 20.0, &neighbours, &[]))
         .unwrap();
-    assert_eq!(serde_json::to_string(&a).unwrap(), serde_json::to_string(&b).unwrap());
+    assert_eq!(
+        serde_json::to_string(&a).unwrap(),
+        serde_json::to_string(&b).unwrap()
+    );
 }
 
 /// Curvature from the plan's own cubic by the textbook formula κ = y''/(1 + y'²)^{3/2}, written
@@ -125,7 +139,11 @@ fn curvature_caps_the_speed_in_a_bend() {
         x_scale_m: plan.cubic_x_scale_m,
         method: planner::cubic_fit::FitMethod::Unconstrained,
     };
-    let xis: Vec<f64> = plan.path.iter().map(|q| frame.to_local([q.x_m, q.y_m])[0]).collect();
+    let xis: Vec<f64> = plan
+        .path
+        .iter()
+        .map(|q| frame.to_local([q.x_m, q.y_m])[0])
+        .collect();
     let mut capped = 0;
     for k in 0..plan.path.len() - 1 {
         let kappa = textbook_curvature(plan.cubic, plan.cubic_x_scale_m, xis[k])
@@ -133,13 +151,23 @@ fn curvature_caps_the_speed_in_a_bend() {
             .max(textbook_curvature(plan.cubic, plan.cubic_x_scale_m, xis[k + 1]).abs());
         let friction_limit = (req.mu * GRAVITY_MPS2 / kappa).sqrt();
         let v = plan.path[k].speed_mps;
-        assert!(v <= friction_limit + 1e-6, "segment {k}: {v} > {friction_limit}");
+        assert!(
+            v <= friction_limit + 1e-6,
+            "segment {k}: {v} > {friction_limit}"
+        );
         if friction_limit < params.speed_limit_mps - 1.0 {
             capped += 1;
         }
     }
-    assert!(capped >= 3, "the bend must bind the friction limit ({capped} segments)");
-    let slowest = plan.path.iter().map(|q| q.speed_mps).fold(f64::INFINITY, f64::min);
+    assert!(
+        capped >= 3,
+        "the bend must bind the friction limit ({capped} segments)"
+    );
+    let slowest = plan
+        .path
+        .iter()
+        .map(|q| q.speed_mps)
+        .fold(f64::INFINITY, f64::min);
     assert!(slowest < 0.8 * req.target_speed_mps, "{slowest}");
     assert!(p.last_stats().cubic_qp, "the heading bound must be active");
     // On the straight with the same μ the target speed is kept.
@@ -171,7 +199,11 @@ fn pf_iso_slows_for_a_faster_vehicle_cutting_in_ahead() {
                 let t = 0.25 * i as f64;
                 // Smooth-step lane change between 1 s and 3 s.
                 let f = ((t - 1.0) / 2.0).clamp(0.0, 1.0);
-                let lateral = if cut_in { 3.5 * f * f * (3.0 - 2.0 * f) } else { 0.0 };
+                let lateral = if cut_in {
+                    3.5 * f * f * (3.0 - 2.0 * f)
+                } else {
+                    0.0
+                };
                 TimedWaypoint {
                     t_s: t0 + t,
                     x_m: 100.0 + 18.0 * t,
@@ -203,13 +235,58 @@ fn pf_iso_slows_for_a_faster_vehicle_cutting_in_ahead() {
         mean(&iso),
         mean(&sp)
     );
-    assert!(iso.iter().zip(&sp).all(|(a, b)| *a <= b + 1e-6), "{iso:?} vs {sp:?}");
+    assert!(
+        iso.iter().zip(&sp).all(|(a, b)| *a <= b + 1e-6),
+        "{iso:?} vs {sp:?}"
+    );
     assert!(
         (mean(&iso_no_cut) - mean(&sp)).abs() < 0.05,
         "no cut-in: ISO {:.3} vs SP {:.3}",
         mean(&iso_no_cut),
         mean(&sp)
     );
+}
+
+/// PF-ISO without a (fresh) SLP of a neighbour predicts it at constant velocity, exactly as
+/// PF-ISO-PRED does.
+#[test]
+fn pf_iso_without_fresh_shared_paths_equals_pf_iso_pred() {
+    let ego = state(100.0, 5.25, 0.0, 15.0);
+    let other = state(98.0, 1.9, 0.05, 19.0);
+    let neighbours = [Neighbour {
+        id: 1,
+        state: other,
+        shape: VehicleShape::default(),
+    }];
+    let pred = planner(PlannerKind::PfIsoPred)
+        .plan(&request(ego, 15.0, &neighbours, &[]))
+        .unwrap();
+    let none = planner(PlannerKind::PfIso)
+        .plan(&request(ego, 15.0, &neighbours, &[]))
+        .unwrap();
+    assert_eq!(pred.path, none.path);
+    // A stale SLP (older than max_shared_path_age_s) is ignored.
+    let stale = SharedLocalPath {
+        vehicle_id: 1,
+        stamp_s: 3.0 - 2.0 * PlannerParams::default().max_shared_path_age_s,
+        shape: VehicleShape::default(),
+        speed_mps: 19.0,
+        waypoints: vec![TimedWaypoint {
+            t_s: 2.0,
+            x_m: 120.0,
+            y_m: 5.25,
+        }],
+    };
+    let shared = [stale];
+    let with_stale = planner(PlannerKind::PfIso)
+        .plan(&request(ego, 15.0, &neighbours, &shared))
+        .unwrap();
+    assert_eq!(pred.path, with_stale.path);
+    // And the interaction term really is in PF-ISO-PRED (it differs from PF-SP here).
+    let sp = planner(PlannerKind::PfSp)
+        .plan(&request(ego, 15.0, &neighbours, &[]))
+        .unwrap();
+    assert_ne!(pred.path, sp.path);
 }
 
 #[test]
@@ -222,7 +299,10 @@ fn solver_failure_returns_a_flagged_comfortable_deceleration() {
     let ego = state(50.0, 1.75, 0.0, 20.0);
     let plan = p.plan(&request(ego, 20.0, &[], &[])).unwrap();
     let Some(FallbackReason::SolverFailed(text)) = &plan.fallback else {
-        panic!("expected a solver-failure fallback, got {:?}", plan.fallback);
+        panic!(
+            "expected a solver-failure fallback, got {:?}",
+            plan.fallback
+        );
     };
     assert!(text.contains("MaxIterations"), "{text}");
     assert!(p.last_stats().fallback);
@@ -231,7 +311,9 @@ fn solver_failure_returns_a_flagged_comfortable_deceleration() {
     let mut s = 0.0;
     for w in plan.path.windows(2) {
         s += ((w[1].x_m - w[0].x_m).powi(2) + (w[1].y_m - w[0].y_m).powi(2)).sqrt();
-        let expected = (400.0 - 2.0 * params.fallback_decel_mps2 * s).max(0.0).sqrt();
+        let expected = (400.0 - 2.0 * params.fallback_decel_mps2 * s)
+            .max(0.0)
+            .sqrt();
         assert!((w[1].speed_mps - expected).abs() < 1e-9);
     }
     assert!(p.last_good_plan().is_none());
@@ -282,14 +364,19 @@ fn non_finite_input_is_a_typed_error() {
     ));
     let mut req = request(ego, 20.0, &[], &[]);
     req.mu = -1.0;
-    assert!(matches!(p.plan(&req), Err(PlannerError::InvalidParameter { .. })));
+    assert!(matches!(
+        p.plan(&req),
+        Err(PlannerError::InvalidParameter { .. })
+    ));
 }
 
 /// Moves a vehicle along its plan for `dt_s`: position and heading from the timed path, speed
 /// ramping from the current speed to the first planned speed over the first segment.
 fn advance(plan: &Plan, now: &VehicleState, t_s: f64) -> VehicleState {
     let path = &plan.path;
-    let k = path.partition_point(|p| p.t_s <= t_s).clamp(1, path.len() - 1);
+    let k = path
+        .partition_point(|p| p.t_s <= t_s)
+        .clamp(1, path.len() - 1);
     let (a, b) = (path[k - 1], path[k]);
     let f = ((t_s - a.t_s) / (b.t_s - a.t_s)).clamp(0.0, 1.0);
     let speed_mps = if k == 1 {
@@ -358,9 +445,16 @@ fn ego_leaves_the_ending_lane_before_the_edge_closes_in() {
             crossed_at_x < road.merge_end_x_m - 20.0,
             "{kind}: crossed at {crossed_at_x}"
         );
-        assert!(min_edge_clearance_m > 0.2, "{kind}: clearance {min_edge_clearance_m}");
+        assert!(
+            min_edge_clearance_m > 0.2,
+            "{kind}: clearance {min_edge_clearance_m}"
+        );
         let upper = road.lane_center_y_m(Lane::Upper);
-        assert!((states[0].y_m - upper).abs() < 0.3, "{kind}: ended at y = {}", states[0].y_m);
+        assert!(
+            (states[0].y_m - upper).abs() < 0.3,
+            "{kind}: ended at y = {}",
+            states[0].y_m
+        );
         println!(
             "{kind}: ego crossed the divider at x = {crossed_at_x:.1} m, min clearance to the \
              lower edge {min_edge_clearance_m:.2} m, final y {:.2} m",

@@ -2,10 +2,8 @@
 //! what `--scenario PATH` reads back.
 
 /// (name, TOML text) of every built-in scenario.
-pub const BUILTINS: &[(&str, &str)] = &[(
-    "urgent_merge",
-    include_str!("../builtin/urgent_merge.toml"),
-)];
+pub const BUILTINS: &[(&str, &str)] =
+    &[("urgent_merge", include_str!("../builtin/urgent_merge.toml"))];
 
 /// Names of the built-in scenarios.
 pub fn names() -> Vec<&'static str> {

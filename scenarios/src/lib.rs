@@ -1,9 +1,17 @@
-//! Scenario definitions: the TOML format, validation and the built-in scenarios.
+//! Scenario definitions: the TOML format, validation, randomisation and the built-in scenarios.
 //!
-//! A scenario is a `[sim]` table (a [`sim::SimConfig`]) and a list of `[[vehicles]]`
-//! ([`sim::VehicleSpec`]). Unknown keys are rejected; every number is range-checked.
+//! A scenario is a `[sim]` table (a [`sim::SimConfig`]), a list of `[[vehicles]]`
+//! ([`sim::VehicleSpec`]) and an optional `[randomise]` table ([`Randomisation`]) of the ranges
+//! a Monte-Carlo sweep draws instances from. Unknown keys are rejected; every number is
+//! range-checked, for the nominal values and for every instance the ranges allow; errors name
+//! the file, the line and the field.
 
 pub mod builtin;
+pub mod distribution;
+pub mod randomisation;
 pub mod scenario;
+pub mod source_location;
 
+pub use distribution::{Distribution, NormalOffset};
+pub use randomisation::{Randomisation, VehicleRandomisation};
 pub use scenario::{Scenario, ScenarioError};

@@ -1,14 +1,18 @@
-//! The scenario file format and its loading.
+//! The scenario file format, its validation and its randomised instances.
 
+use std::fmt;
 use std::path::{Path, PathBuf};
 
+use planner::Lane;
 use serde::{Deserialize, Serialize};
-use sim::{SimConfig, VehicleSpec};
+use sim::{SimConfig, SimError, VehicleSpec};
 use thiserror::Error;
 
 use crate::builtin;
+use crate::randomisation::Randomisation;
+use crate::source_location::line_of;
 
-/// A complete scenario.
+/// A complete scenario: nominal values plus the ranges a sweep draws instances from.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scenario {
@@ -22,6 +26,22 @@ pub struct Scenario {
     pub sim: SimConfig,
     /// The vehicles, in id order.
     pub vehicles: Vec<VehicleSpec>,
+    /// Randomisation ranges for sweeps and `run --seed` (empty: every instance is nominal).
+    #[serde(default, skip_serializing_if = "Randomisation::is_empty")]
+    pub randomise: Randomisation,
+}
+
+/// A line of a scenario text, shown as `, line N` after the file name (nothing if unknown).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Line(pub Option<usize>);
+
+impl fmt::Display for Line {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0 {
+            Some(line) => write!(f, ", line {line}"),
+            None => Ok(()),
+        }
+    }
 }
 
 /// Why a scenario could not be loaded.
@@ -51,13 +71,17 @@ pub enum ScenarioError {
         /// What the TOML reader said, with line and column.
         message: String,
     },
-    /// A value out of its allowed range.
-    #[error("{origin}: {source}")]
+    /// A value out of its allowed range, or values inconsistent with each other.
+    #[error("{origin}{line}: {message}")]
     Invalid {
         /// File name or `built-in NAME`.
         origin: String,
-        /// The simulator's validation error (names the field and value).
-        source: sim::SimError,
+        /// Line of the offending value in the text, when known.
+        line: Line,
+        /// Dotted name of the offending field, when there is one.
+        field: Option<String>,
+        /// What is wrong (names the field and value).
+        message: String,
     },
 }
 
@@ -87,19 +111,146 @@ impl Scenario {
             origin: origin.to_string(),
             message: e.to_string().trim_end().to_string(),
         })?;
-        scenario.validate(origin)?;
+        scenario.check(origin, Some(text))?;
         Ok(scenario)
     }
 
-    /// Checks every value (the simulator's own validation, plus the vehicle list).
+    /// Checks every value, nominal and randomised (see [`Scenario::check`]).
     pub fn validate(&self, origin: &str) -> Result<(), ScenarioError> {
-        let invalid = |source| ScenarioError::Invalid {
-            origin: origin.to_string(),
-            source,
+        self.check(origin, None)
+    }
+
+    /// Checks every value; `text`, if given, is the TOML the scenario came from (for lines).
+    ///
+    /// 1. The simulator's own checks on the nominal values (ranges of every field).
+    /// 2. The randomisation entries (valid distributions, existing vehicle names).
+    /// 3. The simulator's checks at both corners of the randomisation box (every randomised
+    ///    value at its lower end, then at its upper end): these checks are per-field ranges, so
+    ///    passing at both corners means every instance any seed can draw is valid.
+    /// 4. Geometry over the whole box: a vehicle in the lower lane starts where that lane exists
+    ///    (its front before `road.merge_end_x_m`), and no two vehicles can overlap at spawn.
+    pub fn check(&self, origin: &str, text: Option<&str>) -> Result<(), ScenarioError> {
+        let at =
+            |entry: Option<Vec<String>>| Line(text.zip(entry).and_then(|(t, p)| line_of(t, &p)));
+        let sim_error = |e: SimError, prefix: &str, entry: Option<Vec<String>>| {
+            let field = sim_error_field(&e);
+            let nominal = field.as_deref().and_then(|f| self.nominal_path(f));
+            ScenarioError::Invalid {
+                origin: origin.to_string(),
+                line: at(entry.or(nominal)),
+                field,
+                message: format!("{prefix}{e}"),
+            }
         };
-        self.sim.validate().map_err(invalid)?;
-        sim::validate_vehicles(&self.sim, &self.vehicles).map_err(invalid)?;
+        self.sim.validate().map_err(|e| sim_error(e, "", None))?;
+        sim::validate_vehicles(&self.sim, &self.vehicles).map_err(|e| sim_error(e, "", None))?;
+        self.randomise
+            .check_entries(&self.vehicles)
+            .map_err(|issue| ScenarioError::Invalid {
+                origin: origin.to_string(),
+                line: at(Some(issue.path.clone())),
+                field: Some(issue.path.join(".")),
+                message: format!("{}: {}", issue.path.join("."), issue.message),
+            })?;
+        for (upper, end) in [(false, "lower"), (true, "upper")] {
+            let (sim_c, vehicles_c) = self.randomise.corner(&self.sim, &self.vehicles, upper);
+            let prefix = format!("with every randomised value at the {end} end of its range: ");
+            let entry_of = |e: &SimError| {
+                let field = sim_error_field(e)?;
+                match split_vehicle_field(&field) {
+                    Some((name, key)) => self.randomise.vehicle_entry_path(name, key),
+                    None => self.randomise.sim_entry_path(&field),
+                }
+            };
+            sim_c.validate().map_err(|e| {
+                let entry = entry_of(&e);
+                sim_error(e, &prefix, entry)
+            })?;
+            sim::validate_vehicles(&sim_c, &vehicles_c).map_err(|e| {
+                let entry = entry_of(&e);
+                sim_error(e, &prefix, entry)
+            })?;
+        }
+        self.check_geometry(origin, &at)
+    }
+
+    fn check_geometry(
+        &self,
+        origin: &str,
+        at: &dyn Fn(Option<Vec<String>>) -> Line,
+    ) -> Result<(), ScenarioError> {
+        let road = &self.sim.road;
+        // Axis-aligned hull of each vehicle's body over the randomisation box (bodies are boxes
+        // centred on the centre of gravity, spawned with zero yaw).
+        let mut hulls = Vec::with_capacity(self.vehicles.len());
+        for v in &self.vehicles {
+            let params =
+                vehicles::VehicleParams::preset(&v.preset).map_err(|e| ScenarioError::Invalid {
+                    origin: origin.to_string(),
+                    line: at(self.nominal_path(&format!("vehicles[{}].preset", v.name))),
+                    field: Some(format!("vehicles[{}].preset", v.name)),
+                    message: e.to_string(),
+                })?;
+            let b = self.randomise.vehicle_bounds(&v.name);
+            let (half_l, half_w) = (0.5 * params.length_m, 0.5 * params.width_m);
+            let y_c = road.lane_center_y_m(v.lane) + v.y_offset_m;
+            let x = [v.x_m + b.x_m[0] - half_l, v.x_m + b.x_m[1] + half_l];
+            let y = [
+                y_c + b.y_offset_m[0] - half_w,
+                y_c + b.y_offset_m[1] + half_w,
+            ];
+            let x_entry = || {
+                self.randomise
+                    .vehicle_entry_path(&v.name, "x_m")
+                    .or_else(|| self.nominal_path(&format!("vehicles[{}].x_m", v.name)))
+            };
+            if v.lane == Lane::Lower && x[1] > road.merge_end_x_m {
+                return Err(ScenarioError::Invalid {
+                    origin: origin.to_string(),
+                    line: at(x_entry()),
+                    field: Some(format!("vehicles[{}].x_m", v.name)),
+                    message: format!(
+                        "vehicles[{}].x_m = {} (randomised up to {}): the front of a vehicle in \
+                         the lower lane must start before road.merge_end_x_m = {}, where that \
+                         lane ends",
+                        v.name,
+                        v.x_m,
+                        v.x_m + b.x_m[1],
+                        road.merge_end_x_m
+                    ),
+                });
+            }
+            for (other, ox, oy) in &hulls {
+                let overlap = |a: [f64; 2], o: &[f64; 2]| a[0] < o[1] && o[0] < a[1];
+                if overlap(x, ox) && overlap(y, oy) {
+                    return Err(ScenarioError::Invalid {
+                        origin: origin.to_string(),
+                        line: at(x_entry()),
+                        field: Some(format!("vehicles[{}].x_m", v.name)),
+                        message: format!(
+                            "vehicles[{}].x_m = {}: its body can overlap that of vehicle {other} \
+                             at spawn (x over [{:.3}, {:.3}] m vs [{:.3}, {:.3}] m, including \
+                             randomisation)",
+                            v.name, v.x_m, x[0], x[1], ox[0], ox[1]
+                        ),
+                    });
+                }
+            }
+            hulls.push((v.name.clone(), x, y));
+        }
         Ok(())
+    }
+
+    /// The TOML path of a nominal field named as the simulator names it (`mu`,
+    /// `v2v.latency_s`, `vehicles[ego].x_m`).
+    fn nominal_path(&self, field: &str) -> Option<Vec<String>> {
+        if let Some((name, key)) = split_vehicle_field(field) {
+            let index = self.vehicles.iter().position(|v| v.name == name)?;
+            return Some(vec!["vehicles".into(), index.to_string(), key.to_string()]);
+        }
+        let mut path = vec!["sim".to_string()];
+        path.extend(field.split('.').map(str::to_string));
+        Some(path)
     }
 
     /// The scenario as TOML text.
@@ -109,11 +260,57 @@ impl Scenario {
             message: e.to_string(),
         })
     }
+
+    /// The instance drawn with `seed` from the `[randomise]` ranges (DESIGN: "same scenario +
+    /// same seed ⇒ same run"). Deterministic; the instance has no randomisation left, so it is
+    /// its own nominal scenario. For a scenario that passed [`Scenario::check`], every value of
+    /// the instance is valid; otherwise `World::new` reports the bad value.
+    pub fn instantiate(&self, seed: u64) -> Scenario {
+        let (sim, vehicles) = self.randomise.draw(&self.sim, &self.vehicles, seed);
+        Scenario {
+            name: self.name.clone(),
+            description: self.description.clone(),
+            sim,
+            vehicles,
+            randomise: Randomisation::default(),
+        }
+    }
+
+    /// The scenario a run uses: the nominal one without a seed, else [`Scenario::instantiate`].
+    pub fn instance(&self, seed: Option<u64>) -> Scenario {
+        match seed {
+            Some(seed) => self.instantiate(seed),
+            None => self.clone(),
+        }
+    }
+}
+
+/// The field a simulator error names, if any.
+fn sim_error_field(e: &SimError) -> Option<String> {
+    match e {
+        SimError::InvalidParameter { name, .. } => Some(name.clone()),
+        _ => None,
+    }
+}
+
+/// `vehicles[NAME].key` → (`NAME`, `key`).
+fn split_vehicle_field(field: &str) -> Option<(&str, &str)> {
+    let rest = field.strip_prefix("vehicles[")?;
+    let (name, key) = rest.split_once("].")?;
+    Some((name, key))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn urgent() -> &'static str {
+        builtin::toml_of("urgent_merge").unwrap()
+    }
+
+    fn line_of_text(text: &str, needle: &str) -> usize {
+        text.lines().position(|l| l.contains(needle)).unwrap() + 1
+    }
 
     #[test]
     fn every_builtin_loads_and_round_trips() {
@@ -122,30 +319,196 @@ mod tests {
             let text = s.to_toml().unwrap();
             let back = Scenario::from_toml(&text, "round trip").unwrap();
             assert_eq!(s, back, "{name}");
+            assert!(!s.randomise.is_empty(), "{name} carries no randomisation");
         }
     }
 
     #[test]
     fn unknown_key_is_named_with_its_line() {
-        let text = builtin::toml_of("urgent_merge")
-            .unwrap()
-            .replace("mu = 0.8", "mu = 0.8\nfriction = 3");
-        let err = Scenario::from_toml(&text, "x.toml").unwrap_err().to_string();
+        let text = urgent().replace("mu = 0.8", "mu = 0.8\nfriction = 3");
+        let err = Scenario::from_toml(&text, "x.toml")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("friction") && err.contains("line"), "{err}");
     }
 
     #[test]
-    fn out_of_range_value_is_named() {
-        let text = builtin::toml_of("urgent_merge")
-            .unwrap()
-            .replace("mu = 0.8", "mu = -0.5");
-        let err = Scenario::from_toml(&text, "x.toml").unwrap_err().to_string();
+    fn out_of_range_value_is_named_with_file_and_line() {
+        let text = urgent().replace("mu = 0.8", "mu = -0.5");
+        let err = Scenario::from_toml(&text, "x.toml")
+            .unwrap_err()
+            .to_string();
+        let line = line_of_text(&text, "mu = -0.5");
         assert!(err.contains("mu") && err.contains("-0.5"), "{err}");
+        assert!(err.starts_with(&format!("x.toml, line {line}:")), "{err}");
+    }
+
+    #[test]
+    fn vehicle_value_out_of_range_names_vehicle_and_line() {
+        let text = urgent().replacen("\nspeed_mps = 15.0\n", "\nspeed_mps = -4.0\n", 1);
+        let err = Scenario::from_toml(&text, "x.toml")
+            .unwrap_err()
+            .to_string();
+        let line = line_of_text(&text, "speed_mps = -4.0");
+        assert!(
+            err.contains("vehicles[obstacle].speed_mps") && err.contains("-4"),
+            "{err}"
+        );
+        assert!(err.contains(&format!("line {line}")), "{err}");
+    }
+
+    #[test]
+    fn randomisation_that_can_leave_the_valid_range_is_refused() {
+        // μ = 0.8 − 0.9 can reach −0.1.
+        let text = urgent().replace(
+            "mu = { uniform = [-0.1, 0.1] }",
+            "mu = { uniform = [-0.9, 0.1] }",
+        );
+        assert_ne!(text, urgent(), "the built-in changed: update this test");
+        let err = Scenario::from_toml(&text, "x.toml")
+            .unwrap_err()
+            .to_string();
+        let line = line_of_text(&text, "mu = { uniform = [-0.9");
+        assert!(err.contains("lower end") && err.contains("mu"), "{err}");
+        assert!(err.contains(&format!("line {line}")), "{err}");
+    }
+
+    #[test]
+    fn malformed_randomisation_entries_are_named() {
+        let cases = [
+            (
+                "mu = { uniform = [-0.1, 0.1] }",
+                "mu = { uniform = [0.1, -0.1] }",
+                "randomise.mu",
+            ),
+            (
+                "mu = { uniform = [-0.1, 0.1] }",
+                "mu = { normal = { std = 0.1, clip = [0.05, 0.1] } }",
+                "randomise.mu",
+            ),
+            (
+                "mu = { uniform = [-0.1, 0.1] }",
+                "mu = { gaussian = 1.0 }",
+                "gaussian",
+            ),
+            (
+                "[randomise.vehicles.obstacle]",
+                "[randomise.vehicles.obstacel]",
+                "obstacel",
+            ),
+            (
+                "x_m = { uniform = [-3.0, 3.0] }",
+                "z_m = { uniform = [-3.0, 3.0] }",
+                "z_m",
+            ),
+        ];
+        for (from, to, needle) in cases {
+            let text = urgent().replace(from, to);
+            assert_ne!(text, urgent(), "{from}: the built-in changed");
+            let err = Scenario::from_toml(&text, "x.toml")
+                .unwrap_err()
+                .to_string();
+            let line = line_of_text(&text, to);
+            assert!(err.contains(needle), "{to}: {err}");
+            assert!(err.contains(&format!("line {line}")), "{to}: {err}");
+        }
+    }
+
+    #[test]
+    fn spawn_overlap_over_the_randomisation_box_is_refused() {
+        // Both vehicles in the upper lane 6 m apart: BMW 320i bodies are 4.508 m long, so the
+        // nominal gap is 1.492 m, but ±3 m of x randomisation can close it.
+        let text = urgent()
+            .replacen("lane = \"lower\"", "lane = \"upper\"", 1)
+            .replace("x_m = 25.0", "x_m = 6.0");
+        let err = Scenario::from_toml(&text, "x.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("overlap") && err.contains("obstacle"), "{err}");
+        let tight = text.replace(
+            "x_m = { uniform = [-3.0, 3.0] }",
+            "x_m = { uniform = [-1.0, 1.0] }",
+        );
+        assert!(Scenario::from_toml(&tight, "x.toml").is_ok());
+    }
+
+    #[test]
+    fn lower_lane_vehicle_must_start_where_its_lane_exists() {
+        let text = urgent().replace("x_m = 0.0", "x_m = 258.0");
+        let err = Scenario::from_toml(&text, "x.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("vehicles[ego].x_m") && err.contains("merge_end_x_m"),
+            "{err}"
+        );
     }
 
     #[test]
     fn unknown_scenario_lists_builtins() {
         let err = Scenario::load("no_such_scenario").unwrap_err().to_string();
         assert!(err.contains("urgent_merge"), "{err}");
+    }
+
+    #[test]
+    fn instances_are_deterministic_distinct_and_inside_the_ranges() {
+        let s = Scenario::load("urgent_merge").unwrap();
+        assert_eq!(s.instance(None), s);
+        let a = s.instantiate(42);
+        assert_eq!(a, s.instantiate(42));
+        assert_ne!(a, s.instantiate(43));
+        assert!(a.randomise.is_empty());
+        assert_eq!(
+            a.instantiate(7),
+            a,
+            "an instance is its own nominal scenario"
+        );
+        let mut gaps = Vec::new();
+        let mut mus = Vec::new();
+        for seed in 0..2000 {
+            let i = s.instantiate(seed);
+            i.validate("instance").unwrap();
+            let (ego, obs) = (&i.vehicles[0], &i.vehicles[1]);
+            assert_eq!(
+                ego.x_m, s.vehicles[0].x_m,
+                "the ego's position is not randomised"
+            );
+            let gap_offset = obs.x_m - s.vehicles[1].x_m;
+            assert!(gap_offset.abs() <= 3.0, "{gap_offset}");
+            for (v, n) in [(ego, &s.vehicles[0]), (obs, &s.vehicles[1])] {
+                let cruise = v.speed_mps - n.speed_mps;
+                assert!(cruise.abs() <= 1.0);
+                assert_eq!(v.target_speed_mps - n.target_speed_mps, cruise);
+            }
+            assert!((0.7..=0.9).contains(&i.sim.mu), "{}", i.sim.mu);
+            gaps.push(gap_offset);
+            mus.push(i.sim.mu);
+        }
+        // Uniform draws spread over the range: mean near the centre, extremes near the ends.
+        let mean = |xs: &[f64]| xs.iter().sum::<f64>() / xs.len() as f64;
+        assert!(mean(&gaps).abs() < 0.2, "{}", mean(&gaps));
+        assert!((mean(&mus) - 0.8).abs() < 0.01);
+        let max = gaps.iter().cloned().fold(f64::MIN, f64::max);
+        assert!(max > 2.9, "{max}");
+        // The fields use independent streams: the gap and μ offsets are uncorrelated.
+        let (mg, mm) = (mean(&gaps), mean(&mus));
+        let cov: f64 = gaps
+            .iter()
+            .zip(&mus)
+            .map(|(g, m)| (g - mg) * (m - mm))
+            .sum::<f64>()
+            / gaps.len() as f64;
+        let corr = cov / (3.0 / 3f64.sqrt() * (0.1 / 3f64.sqrt()));
+        assert!(corr.abs() < 0.1, "{corr}");
+    }
+
+    #[test]
+    fn a_draw_does_not_depend_on_which_other_values_are_randomised() {
+        let s = Scenario::load("urgent_merge").unwrap();
+        let mut fewer = s.clone();
+        fewer.randomise.mu = None;
+        let (a, b) = (s.instantiate(9), fewer.instantiate(9));
+        assert_eq!(a.vehicles, b.vehicles);
+        assert_eq!(b.sim.mu, s.sim.mu);
     }
 }

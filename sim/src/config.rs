@@ -65,7 +65,9 @@ impl SimConfig {
             value,
             reason: reason.to_string(),
         };
-        self.road.validate().map_err(|e| SimError::InvalidScenario(e.to_string()))?;
+        self.road
+            .validate()
+            .map_err(|e| SimError::InvalidScenario(e.to_string()))?;
         if !(self.mu.is_finite() && self.mu > 0.0 && self.mu <= 2.0) {
             return Err(bad("mu", self.mu, "must lie in (0, 2]"));
         }
@@ -73,7 +75,11 @@ impl SimConfig {
             return Err(bad("dt_s", self.dt_s, "must lie in [0.0001, 0.02] s"));
         }
         if !(self.duration_s.is_finite() && self.duration_s > 0.0 && self.duration_s <= 3600.0) {
-            return Err(bad("duration_s", self.duration_s, "must lie in (0, 3600] s"));
+            return Err(bad(
+                "duration_s",
+                self.duration_s,
+                "must lie in (0, 3600] s",
+            ));
         }
         for (name, value) in [
             ("planner_period_s", self.planner_period_s),

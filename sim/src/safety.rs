@@ -64,6 +64,11 @@ pub struct SafetyParams {
     pub ttc_horizon_s: f64,
     /// Whether to check vehicles against the road edges.
     pub check_road_edges: bool,
+    /// Boxes closer than this count as touching (m). Rapier resolves contacts speculatively:
+    /// two rigid bodies that hit each other (or a barrier) come to rest touching, not
+    /// overlapping, so a physical collision shows as an exact parry distance of about zero
+    /// rather than as an intersection. 0 = intersection only.
+    pub contact_tolerance_m: f64,
 }
 
 impl Default for SafetyParams {
@@ -73,6 +78,7 @@ impl Default for SafetyParams {
             near_miss_gap_m: 0.5,
             ttc_horizon_s: 10.0,
             check_road_edges: true,
+            contact_tolerance_m: 0.01,
         }
     }
 }
@@ -92,6 +98,15 @@ impl SafetyParams {
                     reason: "must be finite and > 0".into(),
                 });
             }
+        }
+        if !(self.contact_tolerance_m.is_finite()
+            && (0.0..=0.1).contains(&self.contact_tolerance_m))
+        {
+            return Err(SafetyError::InvalidParameter {
+                name: "safety.contact_tolerance_m".into(),
+                value: self.contact_tolerance_m,
+                reason: "must lie in [0, 0.1] m".into(),
+            });
         }
         if !(self.near_miss_gap_m.is_finite() && self.near_miss_gap_m >= 0.0) {
             return Err(SafetyError::InvalidParameter {
@@ -512,7 +527,8 @@ impl SafetyMonitor {
         let (pose_a, box_a) = local_box(a, mid_x_m, mid_y_m);
         let (pose_b, box_b) = local_box(b, mid_x_m, mid_y_m);
 
-        let intersecting = if gap_lower_bound_m <= 0.0 {
+        let tolerance_m = self.params.contact_tolerance_m;
+        let overlapping = if gap_lower_bound_m <= 0.0 {
             query::intersection_test(&pose_a, &box_a, &pose_b, &box_b)
                 .map_err(|e| SafetyError::Unsupported(format!("{e:?}")))?
                 .intersecting
@@ -521,9 +537,9 @@ impl SafetyMonitor {
         };
 
         let current_min_gap_m = state.map_or(f64::INFINITY, |s| s.min_gap_m);
-        let (gap_m, gap_is_lower_bound) = if intersecting {
+        let (gap_m, gap_is_lower_bound) = if overlapping {
             (0.0, false)
-        } else if gap_lower_bound_m < current_min_gap_m {
+        } else if gap_lower_bound_m < current_min_gap_m || gap_lower_bound_m <= tolerance_m {
             let d = query::distance(&pose_a, &box_a, &pose_b, &box_b)
                 .map_err(|e| SafetyError::Unsupported(format!("{e:?}")))?
                 .distance;
@@ -531,6 +547,8 @@ impl SafetyMonitor {
         } else {
             (gap_lower_bound_m, true)
         };
+        // Touching within the tolerance is contact (see `contact_tolerance_m`).
+        let intersecting = overlapping || (!gap_is_lower_bound && gap_m <= tolerance_m);
 
         let ttc_s = if intersecting {
             Some(0.0)
@@ -660,9 +678,16 @@ impl SafetyMonitor {
                     Vector::new((a[0] - body.x_m) as f32, (a[1] - body.y_m) as f32, z_mid),
                     Vector::new((b[0] - body.x_m) as f32, (b[1] - body.y_m) as f32, z_mid),
                 );
-                contact = query::intersection_test(&pose, &cuboid, &Pose::identity(), &shape)
-                    .map_err(|e| SafetyError::Unsupported(format!("{e:?}")))?
-                    .intersecting;
+                contact = if self.params.contact_tolerance_m > 0.0 {
+                    let d = query::distance(&pose, &cuboid, &Pose::identity(), &shape)
+                        .map_err(|e| SafetyError::Unsupported(format!("{e:?}")))?
+                        .distance;
+                    f64::from(d) <= self.params.contact_tolerance_m
+                } else {
+                    query::intersection_test(&pose, &cuboid, &Pose::identity(), &shape)
+                        .map_err(|e| SafetyError::Unsupported(format!("{e:?}")))?
+                        .intersecting
+                };
             }
 
             let key = (body.id, edge);

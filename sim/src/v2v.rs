@@ -139,7 +139,12 @@ impl V2vBus {
 
     /// Broadcasts `message` at `t_s` to `receivers` (the sender itself is skipped). Returns false
     /// when the broadcast period has not elapsed (nothing sent).
-    pub fn broadcast(&mut self, t_s: f64, message: &SharedLocalPath, receivers: &[VehicleId]) -> bool {
+    pub fn broadcast(
+        &mut self,
+        t_s: f64,
+        message: &SharedLocalPath,
+        receivers: &[VehicleId],
+    ) -> bool {
         if !self.may_broadcast(message.vehicle_id, t_s) {
             return false;
         }
@@ -284,6 +289,9 @@ mod tests {
             ..V2vParams::default()
         };
         let err = V2vBus::new(params, 1).unwrap_err().to_string();
-        assert!(err.contains("v2v.drop_probability") && err.contains("1.5"), "{err}");
+        assert!(
+            err.contains("v2v.drop_probability") && err.contains("1.5"),
+            "{err}"
+        );
     }
 }

@@ -12,8 +12,8 @@
 use std::time::Instant;
 
 use planner::{
-    Neighbour, PathPoint, PfPlanner, Plan, PlanRequest, PlannerKind, SharedLocalPath,
-    VehicleId, VehicleShape, VehicleState,
+    Neighbour, PathPoint, PfPlanner, Plan, PlanRequest, PlannerKind, SharedLocalPath, VehicleId,
+    VehicleShape, VehicleState,
 };
 use serde::{Deserialize, Serialize};
 use vehicles::{Kinematics, PhysicsWorld, Tracker, Vehicle, VehicleParams};
@@ -176,9 +176,18 @@ impl World {
         physics.add_merge_road(&config.road);
         let mut agents = Vec::with_capacity(specs.len());
         for (index, spec) in specs.iter().enumerate() {
-            agents.push(Self::spawn_agent(&config, &mut physics, index, spec, options)?);
+            agents.push(Self::spawn_agent(
+                &config,
+                &mut physics,
+                index,
+                spec,
+                options,
+            )?);
         }
-        let bus = V2vBus::new(config.v2v.clone(), crate::rng::SplitMix64::derive(options.seed, 1))?;
+        let bus = V2vBus::new(
+            config.v2v.clone(),
+            crate::rng::SplitMix64::derive(options.seed, 1),
+        )?;
         let safety = SafetyMonitor::new(config.safety.clone(), &config.road)
             .map_err(|e| SimError::InvalidScenario(e.to_string()))?;
         let mut world = Self {
@@ -285,7 +294,9 @@ impl World {
             }
             let controls = agent.tracker.update(&kin, &agent.path, dt_s);
             agent.vehicle.set_controls(controls);
-            agent.vehicle.apply_forces(&mut self.physics, self.config.mu);
+            agent
+                .vehicle
+                .apply_forces(&mut self.physics, self.config.mu);
         }
         self.physics.step();
         self.step_index += 1;
@@ -320,23 +331,33 @@ impl World {
         Ok(())
     }
 
+    /// The vehicles' chassis boxes as the safety checks and the recording see them: the
+    /// collider's own box (centred on the wheelbase midpoint, not on the CoG).
     fn body_states(&self, kins: &[Kinematics]) -> Vec<BodyState> {
         self.agents
             .iter()
             .zip(kins)
             .map(|(agent, k)| {
                 let (s, c) = k.yaw_rad.sin_cos();
+                let body_box = agent.vehicle.body_box();
+                let [ox, oy, _] = body_box.center_offset_m;
+                let [hx, hy, hz] = body_box.half_extents_m;
+                // Velocity of the box centre: CoG velocity + ω × offset.
+                let vx_mps = k.vx_body_mps * c - k.vy_body_mps * s;
+                let vy_mps = k.vx_body_mps * s + k.vy_body_mps * c;
+                let off_x = ox * c - oy * s;
+                let off_y = ox * s + oy * c;
                 BodyState {
                     id: agent.id,
-                    x_m: k.x_m,
-                    y_m: k.y_m,
+                    x_m: k.x_m + off_x,
+                    y_m: k.y_m + off_y,
                     yaw_rad: k.yaw_rad,
-                    vx_mps: k.vx_body_mps * c - k.vy_body_mps * s,
-                    vy_mps: k.vx_body_mps * s + k.vy_body_mps * c,
+                    vx_mps: vx_mps - k.yaw_rate_radps * off_y,
+                    vy_mps: vy_mps + k.yaw_rate_radps * off_x,
                     yaw_rate_radps: k.yaw_rate_radps,
-                    length_m: agent.shape.length_m,
-                    width_m: agent.shape.width_m,
-                    height_m: agent.vehicle.params().body_height_m,
+                    length_m: 2.0 * hx,
+                    width_m: 2.0 * hy,
+                    height_m: 2.0 * hz,
                 }
             })
             .collect()
@@ -348,7 +369,9 @@ impl World {
         while self.reported_collisions < collisions.len() {
             let event = &collisions[self.reported_collisions];
             let text = event.describe(&names);
-            self.recorder.log_event(&text, EventLevel::Error).map_err(rec)?;
+            self.recorder
+                .log_event(&text, EventLevel::Error)
+                .map_err(rec)?;
             self.events.push(text);
             for agent in &mut self.agents {
                 if event.involves(agent.id) {
@@ -365,7 +388,9 @@ impl World {
                 "t = {:.3} s: vehicle {name} hit the {:?} road edge",
                 event.t_s, event.edge
             );
-            self.recorder.log_event(&text, EventLevel::Error).map_err(rec)?;
+            self.recorder
+                .log_event(&text, EventLevel::Error)
+                .map_err(rec)?;
             self.events.push(text);
             for agent in &mut self.agents {
                 if agent.id == event.id {
@@ -436,14 +461,17 @@ impl World {
                 vehicle: agent.spec.name.clone(),
                 source,
             })?;
-            self.plan_times_us.push(started.elapsed().as_secs_f64() * 1e6);
+            self.plan_times_us
+                .push(started.elapsed().as_secs_f64() * 1e6);
             if let Some(reason) = &plan.fallback {
                 self.fallbacks += 1;
                 let text = format!(
                     "t = {t_s:.2} s: planner fallback of {}: {reason:?}",
                     agent.spec.name
                 );
-                self.recorder.log_event(&text, EventLevel::Warn).map_err(rec)?;
+                self.recorder
+                    .log_event(&text, EventLevel::Warn)
+                    .map_err(rec)?;
                 self.events.push(text);
             }
             if self.step_index % self.steps_per_field == 0 && self.recorder.is_enabled() {
@@ -476,37 +504,45 @@ impl World {
         }
         for (agent, k) in self.agents.iter_mut().zip(kins) {
             let planned_speed_mps = planned_speed_at(&agent.path, t_s).unwrap_or(k.speed_mps);
-            agent.metrics.push(&MetricsSample {
-                t_s,
-                x_m: k.x_m,
-                y_m: k.y_m,
-                yaw_rad: k.yaw_rad,
-                yaw_rate_radps: k.yaw_rate_radps,
-                sideslip_rad: k.sideslip_rad,
-                speed_mps: k.speed_mps,
-                accel_long_mps2: k.accel_long_mps2,
-                accel_lat_mps2: k.accel_lat_mps2,
-            })
-            .map_err(|e| SimError::Diverged {
-                t_s,
-                what: format!("metrics of {}: {e}", agent.spec.name),
-            })?;
+            agent
+                .metrics
+                .push(&MetricsSample {
+                    t_s,
+                    x_m: k.x_m,
+                    y_m: k.y_m,
+                    yaw_rad: k.yaw_rad,
+                    yaw_rate_radps: k.yaw_rate_radps,
+                    sideslip_rad: k.sideslip_rad,
+                    speed_mps: k.speed_mps,
+                    accel_long_mps2: k.accel_long_mps2,
+                    accel_lat_mps2: k.accel_lat_mps2,
+                })
+                .map_err(|e| SimError::Diverged {
+                    t_s,
+                    what: format!("metrics of {}: {e}", agent.spec.name),
+                })?;
             if self.recorder.is_enabled() {
                 let name = &agent.spec.name;
-                self.recorder.log_scalars(
-                    name,
-                    &[
-                        ("sideslip_rad", k.sideslip_rad),
-                        ("yaw_rad", k.yaw_rad),
-                        ("yaw_rate_radps", k.yaw_rate_radps),
-                        ("speed_mps", k.speed_mps),
-                        ("planned_speed_mps", planned_speed_mps),
-                    ],
-                ).map_err(rec)?;
-                self.recorder.log_planned_path(name, &agent.path).map_err(rec)?;
+                self.recorder
+                    .log_scalars(
+                        name,
+                        &[
+                            ("sideslip_rad", k.sideslip_rad),
+                            ("yaw_rad", k.yaw_rad),
+                            ("yaw_rate_radps", k.yaw_rate_radps),
+                            ("speed_mps", k.speed_mps),
+                            ("planned_speed_mps", planned_speed_mps),
+                        ],
+                    )
+                    .map_err(rec)?;
+                self.recorder
+                    .log_planned_path(name, &agent.path)
+                    .map_err(rec)?;
                 if agent.spec.connected {
                     let received = self.bus.fresh_paths(agent.id, t_s);
-                    self.recorder.log_received_paths(name, &received).map_err(rec)?;
+                    self.recorder
+                        .log_received_paths(name, &received)
+                        .map_err(rec)?;
                 }
             }
             if self.keep_time_series {
@@ -542,7 +578,9 @@ impl World {
                     .map(|t| format!("{t:.2} s"))
                     .unwrap_or_else(|| "none".into())
             );
-            self.recorder.log_event(&text, EventLevel::Warn).map_err(rec)?;
+            self.recorder
+                .log_event(&text, EventLevel::Warn)
+                .map_err(rec)?;
             self.events.push(text);
         }
         let mut times = self.plan_times_us.clone();
@@ -578,7 +616,14 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 }
 
 fn check_finite(t_s: f64, name: &str, k: &Kinematics) -> Result<(), SimError> {
-    let values = [k.x_m, k.y_m, k.z_m, k.yaw_rad, k.speed_mps, k.yaw_rate_radps];
+    let values = [
+        k.x_m,
+        k.y_m,
+        k.z_m,
+        k.yaw_rad,
+        k.speed_mps,
+        k.yaw_rate_radps,
+    ];
     if values.iter().all(|v| v.is_finite()) && k.z_m.abs() < 50.0 {
         Ok(())
     } else {
@@ -598,7 +643,11 @@ fn planned_speed_at(path: &[PathPoint], t_s: f64) -> Option<f64> {
     for pair in path.windows(2) {
         if t_s <= pair[1].t_s {
             let span = pair[1].t_s - pair[0].t_s;
-            let w = if span > 0.0 { (t_s - pair[0].t_s) / span } else { 1.0 };
+            let w = if span > 0.0 {
+                (t_s - pair[0].t_s) / span
+            } else {
+                1.0
+            };
             return Some(pair[0].speed_mps + w * (pair[1].speed_mps - pair[0].speed_mps));
         }
     }
@@ -606,7 +655,12 @@ fn planned_speed_at(path: &[PathPoint], t_s: f64) -> Option<f64> {
 }
 
 /// A straight path along the spawn lane's centre at the target speed (driver without planner).
-fn lane_keeping_path(config: &SimConfig, spec: &VehicleSpec, k: &Kinematics, t_s: f64) -> Vec<PathPoint> {
+fn lane_keeping_path(
+    config: &SimConfig,
+    spec: &VehicleSpec,
+    k: &Kinematics,
+    t_s: f64,
+) -> Vec<PathPoint> {
     let y_m = config.road.lane_center_y_m(spec.lane) + spec.y_offset_m;
     let v = spec.target_speed_mps;
     (0..=10)

@@ -25,6 +25,15 @@ fn monitor() -> SafetyMonitor {
     SafetyMonitor::new(SafetyParams::default(), &MergeRoad::default()).unwrap()
 }
 
+/// Monitor that counts only true overlap as contact (no touching tolerance).
+fn exact_monitor() -> SafetyMonitor {
+    let params = SafetyParams {
+        contact_tolerance_m: 0.0,
+        ..SafetyParams::default()
+    };
+    SafetyMonitor::new(params, &MergeRoad::default()).unwrap()
+}
+
 /// Monitor without road edges, for pair tests placed anywhere.
 fn pair_monitor() -> SafetyMonitor {
     let params = SafetyParams {
@@ -269,7 +278,7 @@ fn box_crossing_the_lower_edge_in_the_taper_is_an_edge_contact() {
         yaw_rad: heading,
         ..car(0, x, edge_y + offset_m / heading.cos(), heading, 20.0, 0.0)
     };
-    let mut m = monitor();
+    let mut m = exact_monitor();
     let r = m.check(0.0, &[at(1.0005)], 0.01).unwrap();
     assert!(r.new_edge_contacts.is_empty());
     let r = m.check(0.01, &[at(0.9995)], 0.01).unwrap();
@@ -390,4 +399,35 @@ fn summary_serialises_with_the_documented_fields() {
     }
     let back: sim::safety::SafetySummary = serde_json::from_value(json).unwrap();
     assert_eq!(back, m.summary());
+}
+
+#[test]
+fn touching_within_the_tolerance_is_contact() {
+    // Rapier brings colliding boxes to rest touching, not overlapping: a gap below
+    // `contact_tolerance_m` (default 1 cm) is contact, a larger one is not.
+    let tolerance_m = SafetyParams::default().contact_tolerance_m;
+    let mut m = pair_monitor();
+    let length_m = car(0, 0.0, 0.0, 0.0, 0.0, 0.0).length_m;
+    let r = m
+        .check(
+            0.0,
+            &[
+                car(0, 0.0, 0.0, 0.0, 0.0, 0.0),
+                car(1, length_m + 2.0 * tolerance_m, 0.0, 0.0, 0.0, 0.0),
+            ],
+            0.01,
+        )
+        .unwrap();
+    assert!(r.new_collisions.is_empty());
+    let r = m
+        .check(
+            0.01,
+            &[
+                car(0, 0.0, 0.0, 0.0, 0.0, 0.0),
+                car(1, length_m + 0.5 * tolerance_m, 0.0, 0.0, 0.0, 0.0),
+            ],
+            0.01,
+        )
+        .unwrap();
+    assert_eq!(r.new_collisions.len(), 1);
 }

@@ -111,16 +111,16 @@ struct ManeuverArgs {
     #[arg(long, default_value = "bmw_320i")]
     vehicle: String,
     /// Tire–road friction coefficient μ (> 0).
-    #[arg(long, default_value_t = 0.8)]
+    #[arg(long, default_value_t = 0.8, allow_negative_numbers = true)]
     mu: f64,
     /// Speed (m/s).
-    #[arg(long, default_value_t = 20.0)]
+    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
     speed_mps: f64,
     /// Front wheel steering angle (rad).
     #[arg(long, default_value_t = 0.02, allow_negative_numbers = true)]
     steer_rad: f64,
     /// Physics step (s).
-    #[arg(long, default_value_t = 0.002)]
+    #[arg(long, default_value_t = 0.002, allow_negative_numbers = true)]
     dt_s: f64,
     /// Write the report as JSON here.
     #[arg(long, value_name = "PATH")]
@@ -241,8 +241,8 @@ fn simulate(
         seed: seed.unwrap_or(0),
         keep_time_series,
     };
-    let world = World::new(scenario.sim.clone(), &scenario.vehicles, &options, recorder)
-        .map_err(input)?;
+    let world =
+        World::new(scenario.sim.clone(), &scenario.vehicles, &options, recorder).map_err(input)?;
     let started = Instant::now();
     let progress = progress_printer(show_progress, format!("{} {label}", scenario.name));
     let outcome = world.run(progress).map_err(run_failure)?;
@@ -304,7 +304,11 @@ fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
             println!("event: {event}");
         }
         if let Some(path) = &rrd {
-            println!("recording: {} (open with `rerun {}`)", path.display(), path.display());
+            println!(
+                "recording: {} (open with `rerun {}`)",
+                path.display(),
+                path.display()
+            );
         }
     }
     if args.view
@@ -313,7 +317,9 @@ fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
         std::process::Command::new("rerun")
             .arg(path)
             .spawn()
-            .context("cannot start the Rerun viewer `rerun` (install: pip install rerun-sdk==0.36.3)")
+            .context(
+                "cannot start the Rerun viewer `rerun` (install: pip install rerun-sdk==0.36.3)",
+            )
             .map_err(run_failure)?;
     }
     Ok(())
@@ -356,10 +362,14 @@ fn comparison_table(summaries: &[RunSummary]) -> String {
     };
     row("collisions", &|s| s.collisions.to_string());
     row("min gap m", &|s| {
-        s.min_gap_m.map(|g| format!("{g:.2}")).unwrap_or_else(|| "-".into())
+        s.min_gap_m
+            .map(|g| format!("{g:.2}"))
+            .unwrap_or_else(|| "-".into())
     });
     row("min TTC s", &|s| {
-        s.min_ttc_s.map(|t| format!("{t:.2}")).unwrap_or_else(|| "-".into())
+        s.min_ttc_s
+            .map(|t| format!("{t:.2}"))
+            .unwrap_or_else(|| "-".into())
     });
     row("near miss", &|s| s.near_miss.to_string());
     row("fallbacks", &|s| s.planner_stats.fallbacks.to_string());
@@ -370,22 +380,34 @@ fn comparison_table(summaries: &[RunSummary]) -> String {
     for (i, name) in names.iter().enumerate() {
         let get = |s: &RunSummary| s.vehicles.get(i).cloned();
         row(&format!("{name} |β|max rad"), &|s| {
-            get(s).map(|v| format!("{:.4}", v.max_abs_sideslip_rad)).unwrap_or_default()
+            get(s)
+                .map(|v| format!("{:.4}", v.max_abs_sideslip_rad))
+                .unwrap_or_default()
         });
         row(&format!("{name} |ψ|max rad"), &|s| {
-            get(s).map(|v| format!("{:.4}", v.max_abs_yaw_rad)).unwrap_or_default()
+            get(s)
+                .map(|v| format!("{:.4}", v.max_abs_yaw_rad))
+                .unwrap_or_default()
         });
         row(&format!("{name} |r|max rad/s"), &|s| {
-            get(s).map(|v| format!("{:.4}", v.max_abs_yaw_rate_radps)).unwrap_or_default()
+            get(s)
+                .map(|v| format!("{:.4}", v.max_abs_yaw_rate_radps))
+                .unwrap_or_default()
         });
         row(&format!("{name} v_min m/s"), &|s| {
-            get(s).map(|v| format!("{:.2}", v.min_speed_mps)).unwrap_or_default()
+            get(s)
+                .map(|v| format!("{:.2}", v.min_speed_mps))
+                .unwrap_or_default()
         });
         row(&format!("{name} path m"), &|s| {
-            get(s).map(|v| format!("{:.1}", v.path_length_m)).unwrap_or_default()
+            get(s)
+                .map(|v| format!("{:.1}", v.path_length_m))
+                .unwrap_or_default()
         });
         row(&format!("{name} r sign changes"), &|s| {
-            get(s).map(|v| v.yaw_rate_sign_changes.to_string()).unwrap_or_default()
+            get(s)
+                .map(|v| v.yaw_rate_sign_changes.to_string())
+                .unwrap_or_default()
         });
     }
     out
