@@ -7,5 +7,6 @@
 
 pub mod output;
 pub mod summary;
+pub mod sweep;
 
 pub use {planner, scenarios, sim, vehicles};

@@ -286,3 +286,25 @@ fn maneuver_json_has_the_documented_keys() {
         "{d} vs {reference}"
     );
 }
+
+#[test]
+fn two_runs_write_identical_json_but_for_wall_clock_fields() {
+    let dir = scratch("determinism");
+    let read = |name: &str| {
+        let path = dir.join(name);
+        let out = merge_sim(&["run", "--no-rrd", "--quiet", "--json", path.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        // Wall-clock measurements are the only fields allowed to differ.
+        let obj = v.as_object_mut().unwrap();
+        obj.remove("wall_time_s");
+        let stats = obj["planner_stats"].as_object_mut().unwrap();
+        stats.remove("p50_plan_us");
+        stats.remove("p99_plan_us");
+        v
+    };
+    let a = read("a.json");
+    let b = read("b.json");
+    assert_eq!(a, b);
+}

@@ -119,6 +119,17 @@ impl ObstacleField {
         }
     }
 
+    /// The same field with its front half shrunk to the contact distance (l + l_o)/2: only the
+    /// vehicle behind keeps the speed-dependent gap (the follower is responsible for it, as in
+    /// RSS). Used by the interaction term of Eq. 10 when `interaction_rear_only` is set.
+    pub fn rear_only(&self, half_lengths_m: f64, params: &PlannerParams) -> Self {
+        let x_scale = (-2.0 * params.obstacle_fraction_at_min_distance.ln()).sqrt();
+        Self {
+            sigma_front_m: half_lengths_m / x_scale,
+            ..*self
+        }
+    }
+
     /// The same field moved to another centre and heading (same σ's).
     pub fn moved_to(&self, x_m: f64, y_m: f64, cos_heading: f64, sin_heading: f64) -> Self {
         Self {

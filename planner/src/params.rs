@@ -113,6 +113,18 @@ pub struct PlannerParams {
     /// contour, i.e. at 3–4 σ_x, so vehicles at a safe following distance keep pushing each
     /// other's speeds away from their targets.
     pub interaction_floor: f64,
+    /// In the interaction term, a vehicle behind the planning vehicle counts only within the
+    /// contact distance (l + l_o)/2 ahead of it, while a vehicle ahead keeps its full
+    /// speed-dependent D_min behind it: the follower is responsible for the gap (as in RSS),
+    /// so a merging vehicle makes the one it cuts in front of slow down, and a leader is not
+    /// pushed above its target speed by a vehicle following it.
+    pub interaction_rear_only: bool,
+    /// In PF-ISO / PF-ISO-PRED, cap the speeds at max(V_target, v0 − a_max·t): the interaction
+    /// term may slow a vehicle down ("slowing down in advance", as in the paper) but not push
+    /// it above its target. Without the cap the non-convex term can also be lowered by
+    /// accelerating past the other vehicle, a race that a receiver predicting at constant
+    /// velocity (no V2V) may run into.
+    pub interaction_slows_only: bool,
     /// Half-width of the SCP trust region on each speed after the first iteration (m/s).
     pub trust_region_mps: f64,
     /// Maximum number of SCP iterations (each one convex solve; ≥ 1).
@@ -174,6 +186,8 @@ impl Default for PlannerParams {
             speed_deviation_weight: 1.0,
             interaction_weight: 10.0,
             interaction_floor: 0.1,
+            interaction_rear_only: true,
+            interaction_slows_only: false,
             trust_region_mps: 2.0,
             max_scp_iterations: 2,
             scp_relative_tolerance: 1e-4,

@@ -446,12 +446,21 @@ impl PfPlanner {
                 n
             ],
             PlannerKind::PfSp | PlannerKind::PfIso | PlannerKind::PfIsoPred => {
-                let max_speeds_mps = friction_speed_limits(
+                let mut max_speeds_mps = friction_speed_limits(
                     |xi| cubic.curvature_per_m(xi),
                     &xis,
                     req.mu,
                     params.speed_limit_mps,
                 );
+                if self.kind != PlannerKind::PfSp && params.interaction_slows_only {
+                    // The interaction may only slow the vehicle: cap at V_target, or at a
+                    // comfortable deceleration from the current speed if that is higher.
+                    let decel_mps = params.max_accel_mps2 * params.step_time_s;
+                    for (i, v) in max_speeds_mps.iter_mut().enumerate() {
+                        let from_now = req.ego.speed_mps - decel_mps * (i + 1) as f64;
+                        *v = v.min(req.target_speed_mps.max(from_now));
+                    }
+                }
                 let interaction = if self.kind == PlannerKind::PfSp {
                     None
                 } else {
@@ -465,10 +474,16 @@ impl PfPlanner {
                         let bases: Vec<(ObstacleField, &Trajectory)> = others
                             .values()
                             .map(|(trajectory, speed, shape)| {
-                                (
-                                    ObstacleField::new(params, me, 0.0, 0.0, 0.0, *speed, shape),
-                                    trajectory,
-                                )
+                                let field =
+                                    ObstacleField::new(params, me, 0.0, 0.0, 0.0, *speed, shape);
+                                let field = if params.interaction_rear_only {
+                                    let half_lengths_m =
+                                        0.5 * (req.ego_shape.length_m + shape.length_m);
+                                    field.rear_only(half_lengths_m, params)
+                                } else {
+                                    field
+                                };
+                                (field, trajectory)
                             })
                             .collect();
                         let fields = (1..=n)

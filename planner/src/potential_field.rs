@@ -276,6 +276,27 @@ mod tests {
         }
     }
 
+    /// With the default gains the lateral force vanishes within a few centimetres of each
+    /// lane centre (found by bisection on F_y), and pushes back towards it on either side.
+    #[test]
+    fn default_lane_equilibria_sit_at_the_lane_centres() {
+        let params = PlannerParams::default();
+        let road = MergeRoad::default();
+        let ego = state(0.0, 1.75, 0.0, 20.0);
+        let field = PotentialField::new(&params, &road, 0, &ego, &VehicleShape::default(), &[]);
+        for lane in [crate::road::Lane::Lower, crate::road::Lane::Upper] {
+            let centre = road.lane_center_y_m(lane);
+            let fy = |y: f64| field.stepping_force(50.0, y)[1];
+            let (mut lo, mut hi) = (centre - 0.6, centre + 0.6);
+            assert!(fy(lo) > 0.0 && fy(hi) < 0.0, "restoring on both sides");
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if fy(mid) > 0.0 { lo = mid } else { hi = mid }
+            }
+            assert!((lo - centre).abs() < 0.05, "{lane:?}: equilibrium at {lo}");
+        }
+    }
+
     #[test]
     fn own_entry_among_neighbours_is_skipped() {
         let params = PlannerParams::default();

@@ -247,6 +247,33 @@ fn pf_iso_slows_for_a_faster_vehicle_cutting_in_ahead() {
     );
 }
 
+/// A faster vehicle closing in from 25 m behind in the same lane (17 vs 15 m/s, still 15 m
+/// behind at the horizon): with `interaction_rear_only` (the follower is responsible for the
+/// gap) the leader keeps its PF-SP speeds; without it, the leader is pushed to speed up.
+#[test]
+fn a_follower_does_not_push_the_leader_when_the_follower_is_responsible() {
+    let ego = state(100.0, 5.25, 0.0, 15.0);
+    let neighbours = [Neighbour {
+        id: 1,
+        state: state(75.0, 5.25, 0.0, 17.0),
+        shape: VehicleShape::default(),
+    }];
+    let mean_speed = |kind: PlannerKind, rear_only: bool| {
+        let params = PlannerParams {
+            interaction_rear_only: rear_only,
+            ..PlannerParams::default()
+        };
+        let plan = PfPlanner::new(kind, params, MergeRoad::default())
+            .unwrap()
+            .plan(&request(ego, 15.0, &neighbours, &[]))
+            .unwrap();
+        plan.path.iter().map(|p| p.speed_mps).sum::<f64>() / plan.path.len() as f64
+    };
+    let sp = mean_speed(PlannerKind::PfSp, true);
+    assert!((mean_speed(PlannerKind::PfIsoPred, true) - sp).abs() < 0.05);
+    assert!(mean_speed(PlannerKind::PfIsoPred, false) > sp + 0.3);
+}
+
 /// PF-ISO without a (fresh) SLP of a neighbour predicts it at constant velocity, exactly as
 /// PF-ISO-PRED does.
 #[test]

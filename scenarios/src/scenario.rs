@@ -154,7 +154,6 @@ impl Scenario {
             })?;
         for (upper, end) in [(false, "lower"), (true, "upper")] {
             let (sim_c, vehicles_c) = self.randomise.corner(&self.sim, &self.vehicles, upper);
-            let prefix = format!("with every randomised value at the {end} end of its range: ");
             let entry_of = |e: &SimError| {
                 let field = sim_error_field(e)?;
                 match split_vehicle_field(&field) {
@@ -162,14 +161,19 @@ impl Scenario {
                     None => self.randomise.sim_entry_path(&field),
                 }
             };
-            sim_c.validate().map_err(|e| {
+            let corner_error = |e: SimError| {
                 let entry = entry_of(&e);
+                let prefix = format!(
+                    "{}at the {end} end of the randomisation range: ",
+                    entry
+                        .as_ref()
+                        .map(|p| format!("{}: ", p.join(".")))
+                        .unwrap_or_default()
+                );
                 sim_error(e, &prefix, entry)
-            })?;
-            sim::validate_vehicles(&sim_c, &vehicles_c).map_err(|e| {
-                let entry = entry_of(&e);
-                sim_error(e, &prefix, entry)
-            })?;
+            };
+            sim_c.validate().map_err(corner_error)?;
+            sim::validate_vehicles(&sim_c, &vehicles_c).map_err(corner_error)?;
         }
         self.check_geometry(origin, &at)
     }
@@ -369,7 +373,10 @@ mod tests {
             .unwrap_err()
             .to_string();
         let line = line_of_text(&text, "mu = { uniform = [-0.9");
-        assert!(err.contains("lower end") && err.contains("mu"), "{err}");
+        assert!(
+            err.contains("randomise.mu: at the lower end") && err.contains("mu = -0.09"),
+            "{err}"
+        );
         assert!(err.contains(&format!("line {line}")), "{err}");
     }
 

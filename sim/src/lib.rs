@@ -3,6 +3,7 @@
 pub mod body_state;
 pub mod config;
 pub mod error;
+pub mod idm;
 pub mod metrics;
 pub mod recording;
 pub mod rng;

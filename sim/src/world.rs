@@ -123,6 +123,8 @@ struct Agent {
     path: Vec<PathPoint>,
     last_plan: Option<Plan>,
     metrics: VehicleMetrics,
+    /// Whether a vehicle that started in the ending lane has crossed the divider yet.
+    merged: bool,
 }
 
 /// Options of one run that are not part of the scenario.
@@ -250,6 +252,7 @@ impl World {
             path: Vec::new(),
             last_plan: None,
             metrics: VehicleMetrics::new(spec.name.clone()),
+            merged: spec.lane == planner::Lane::Upper,
         })
     }
 
@@ -502,7 +505,17 @@ impl World {
             self.recorder.set_time(t_s).map_err(rec)?;
             self.recorder.log_vehicles(&bodies, &names).map_err(rec)?;
         }
+        let y_lane_m = self.config.road.y_lane_m();
         for (agent, k) in self.agents.iter_mut().zip(kins) {
+            if !agent.merged && k.y_m > y_lane_m {
+                agent.merged = true;
+                let text = format!(
+                    "t = {t_s:.2} s: {} crossed the lane divider at x = {:.1} m",
+                    agent.spec.name, k.x_m
+                );
+                self.recorder.log_event(&text, EventLevel::Info).map_err(rec)?;
+                self.events.push(text);
+            }
             let planned_speed_mps = planned_speed_at(&agent.path, t_s).unwrap_or(k.speed_mps);
             agent
                 .metrics

@@ -43,6 +43,12 @@ enum Command {
     /// List or print the built-in scenarios.
     #[command(subcommand)]
     Scenario(ScenarioCommand),
+    /// Seeded Monte-Carlo sweep: N randomised instances in parallel, collision / near-miss
+    /// statistics (instance i runs with seed SplitMix64::derive(--seed, i); replay it alone with
+    /// `merge_sim run --scenario S --planner P --seed <that seed>`).
+    Sweep(SweepArgs),
+    /// Combine the --json files of the shards of one sweep into the aggregate of the whole sweep.
+    MergeResults(MergeResultsArgs),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -53,7 +59,9 @@ struct RunArgs {
     /// Planner of every planner-driven vehicle (overrides the scenario's choice).
     #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
     planner: Option<PlannerKind>,
-    /// Seed of the run's random streams (V2V drops). Without it the nominal scenario runs.
+    /// Run the scenario instance drawn with seed N from its [randomise] ranges (N also seeds
+    /// the V2V drops); a sweep's per-run rows give each run's seed. Without it the nominal
+    /// scenario runs.
     #[arg(long, value_name = "N")]
     seed: Option<u64>,
     /// Where to write the Rerun recording [default: <scenario>_<planner>.rrd].
@@ -85,7 +93,8 @@ struct CompareArgs {
     #[arg(long, value_delimiter = ',', value_parser = parse_planner,
           default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
     planners: Vec<PlannerKind>,
-    /// Seed of the runs' random streams.
+    /// Compare on the scenario instance drawn with seed N (as `run --seed N`); without it the
+    /// nominal scenario.
     #[arg(long, value_name = "N")]
     seed: Option<u64>,
     /// Write the JSON summaries (an array) here.
@@ -164,6 +173,8 @@ fn main() -> ExitCode {
         Some(Command::Compare(args)) => cmd_compare(&args),
         Some(Command::Maneuver(args)) => cmd_maneuver(&args),
         Some(Command::Scenario(cmd)) => cmd_scenario(&cmd),
+        Some(Command::Sweep(args)) => cmd_sweep(&args),
+        Some(Command::MergeResults(args)) => cmd_merge_results(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -241,8 +252,10 @@ fn simulate(
         seed: seed.unwrap_or(0),
         keep_time_series,
     };
+    // With a seed, the instance drawn from the scenario's [randomise] ranges (as a sweep runs it).
+    let instance = scenario.instance(seed);
     let world =
-        World::new(scenario.sim.clone(), &scenario.vehicles, &options, recorder).map_err(input)?;
+        World::new(instance.sim, &instance.vehicles, &options, recorder).map_err(input)?;
     let started = Instant::now();
     let progress = progress_printer(show_progress, format!("{} {label}", scenario.name));
     let outcome = world.run(progress).map_err(run_failure)?;
@@ -460,6 +473,177 @@ fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
             })?;
             print!("{text}");
         }
+    }
+    Ok(())
+}
+
+#[derive(Args, Debug)]
+struct SweepArgs {
+    /// Built-in scenario name or path to a scenario TOML file.
+    #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
+    scenario: String,
+    /// Planner of every planner-driven vehicle (overrides the scenario's choice).
+    #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
+    planner: Option<PlannerKind>,
+    /// Number of randomised instances in the whole sweep (at least 1).
+    #[arg(long, value_name = "N", value_parser = parse_runs)]
+    runs: u64,
+    /// Sweep seed K: instance i runs with seed SplitMix64::derive(K, i), which `run --seed`
+    /// replays.
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    seed: u64,
+    /// Run only shard i of n (0-based): instances [⌊i·N/n⌋, ⌊(i+1)·N/n⌋). Default: from a Slurm
+    /// job array (SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_COUNT), a Kubernetes Indexed Job
+    /// (JOB_COMPLETION_INDEX with MERGESIM_SHARD_COUNT), else the whole sweep (0/1).
+    #[arg(long, value_name = "i/n", value_parser = parse_shard)]
+    shard: Option<mergesim::sweep::Shard>,
+    /// Write the aggregate JSON here (with per-run samples, so shards can be merged).
+    #[arg(long, value_name = "PATH")]
+    json: Option<PathBuf>,
+    /// Write one JSON line per run here (instance, seed, status, figures, wall time).
+    #[arg(long, value_name = "PATH")]
+    jsonl: Option<PathBuf>,
+    /// Worker threads [default: one per core].
+    #[arg(long, value_name = "N", value_parser = parse_threads)]
+    threads: Option<usize>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(Args, Debug)]
+struct MergeResultsArgs {
+    /// The `sweep --json` files of every shard of one sweep, in any order.
+    #[arg(required = true, value_name = "SHARD_JSON")]
+    inputs: Vec<PathBuf>,
+    /// Write the aggregate of the whole sweep here.
+    #[arg(long, value_name = "PATH")]
+    json: Option<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+fn parse_runs(text: &str) -> Result<u64, String> {
+    match text.parse::<u64>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(n) => Ok(n),
+        Err(_) => Err("expected a whole number of runs, at least 1".into()),
+    }
+}
+
+fn parse_threads(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(0) | Err(_) => Err("expected a whole number of threads, at least 1".into()),
+        Ok(n) => Ok(n),
+    }
+}
+
+fn parse_shard(text: &str) -> Result<mergesim::sweep::Shard, String> {
+    text.parse().map_err(|e: mergesim::sweep::ShardError| e.to_string())
+}
+
+fn sweep_failure(e: mergesim::sweep::SweepError) -> Failure {
+    match e {
+        mergesim::sweep::SweepError::Invalid(_) => input(e),
+        mergesim::sweep::SweepError::Threads(_) => run_failure(e),
+    }
+}
+
+fn write_output(path: &Path, text: &str) -> Result<(), Failure> {
+    write_atomically(path, text.as_bytes())
+        .with_context(|| format!("cannot write {}", path.display()))
+        .map_err(run_failure)
+}
+
+fn cmd_sweep(args: &SweepArgs) -> Result<(), Failure> {
+    use mergesim::sweep::{Shard, SweepOptions, SweepPlan, run_sweep};
+    let scenario = Scenario::load(&args.scenario).map_err(input)?;
+    for (path, what) in [(args.json.as_deref(), "--json"), (args.jsonl.as_deref(), "--jsonl")] {
+        if let Some(path) = path {
+            check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
+        }
+    }
+    let shard = match args.shard {
+        Some(shard) => shard,
+        None => Shard::from_environment(|name| std::env::var(name).ok())
+            .map_err(input)?
+            .unwrap_or(Shard::WHOLE),
+    };
+    let plan = SweepPlan {
+        scenario,
+        planner: args.planner,
+        runs: args.runs,
+        seed: args.seed,
+        shard,
+    };
+    let instances = shard.instances(args.runs);
+    let bar = if !args.quiet && std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(instances.end - instances.start);
+        let style = indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:40}] {pos}/{len} runs, {per_sec}, ETA {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+        bar.set_style(style);
+        bar.set_message(format!("sweep {} shard {shard}", plan.scenario.name));
+        bar
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let options = SweepOptions {
+        threads: args.threads,
+    };
+    let outcome = run_sweep(&plan, &options, &|| bar.inc(1)).map_err(sweep_failure)?;
+    bar.finish_and_clear();
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&outcome.summary).map_err(run_failure)?;
+        write_output(path, &text)?;
+    }
+    if let Some(path) = &args.jsonl {
+        let text = outcome
+            .summary
+            .jsonl(&outcome.run_wall_times_s)
+            .map_err(run_failure)?;
+        write_output(path, &text)?;
+    }
+    if !args.quiet {
+        print!("{}", outcome.summary.table());
+        for row in outcome.summary.samples.iter().filter(|r| r.error.is_some()) {
+            println!(
+                "run {} (seed {}) {:?}: {}",
+                row.instance,
+                row.seed,
+                row.status,
+                row.error.as_deref().unwrap_or_default()
+            );
+        }
+    }
+    Ok(())
+}
+
+fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> {
+    use mergesim::sweep::{SweepSummary, merge_shards};
+    if let Some(path) = &args.json {
+        check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
+    }
+    let mut parts = Vec::with_capacity(args.inputs.len());
+    for path in &args.inputs {
+        let origin = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {origin}"))
+            .map_err(input)?;
+        let part: SweepSummary = serde_json::from_str(&text)
+            .with_context(|| format!("{origin}: not a `merge_sim sweep --json` file"))
+            .map_err(input)?;
+        parts.push((origin, part));
+    }
+    let merged = merge_shards(parts).map_err(sweep_failure)?;
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&merged).map_err(run_failure)?;
+        write_output(path, &text)?;
+    }
+    if !args.quiet {
+        print!("{}", merged.table());
     }
     Ok(())
 }
