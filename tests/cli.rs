@@ -292,7 +292,13 @@ fn two_runs_write_identical_json_but_for_wall_clock_fields() {
     let dir = scratch("determinism");
     let read = |name: &str| {
         let path = dir.join(name);
-        let out = merge_sim(&["run", "--no-rrd", "--quiet", "--json", path.to_str().unwrap()]);
+        let out = merge_sim(&[
+            "run",
+            "--no-rrd",
+            "--quiet",
+            "--json",
+            path.to_str().unwrap(),
+        ]);
         assert!(out.status.success(), "{}", stderr(&out));
         let mut v: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();

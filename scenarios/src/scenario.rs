@@ -308,8 +308,41 @@ fn split_vehicle_field(field: &str) -> Option<(&str, &str)> {
 mod tests {
     use super::*;
 
+    /// A fixed scenario text for these tests (the built-ins may be retuned).
     fn urgent() -> &'static str {
-        builtin::toml_of("urgent_merge").unwrap()
+        r#"name = "two_cars"
+
+[sim]
+mu = 0.8
+duration_s = 25.0
+
+[[vehicles]]
+name = "ego"
+preset = "bmw_320i"
+lane = "lower"
+x_m = 0.0
+speed_mps = 20.0
+target_speed_mps = 20.0
+driver = { planner = "pf-iso" }
+
+[[vehicles]]
+name = "obstacle"
+preset = "bmw_320i"
+lane = "upper"
+x_m = 25.0
+speed_mps = 15.0
+target_speed_mps = 15.0
+driver = { planner = "pf-iso" }
+
+[randomise]
+mu = { uniform = [-0.1, 0.1] }
+
+[randomise.every_vehicle]
+cruise_speed_mps = { uniform = [-1.0, 1.0] }
+
+[randomise.vehicles.obstacle]
+x_m = { uniform = [-3.0, 3.0] }
+"#
     }
 
     fn line_of_text(text: &str, needle: &str) -> usize {
@@ -459,7 +492,7 @@ mod tests {
 
     #[test]
     fn instances_are_deterministic_distinct_and_inside_the_ranges() {
-        let s = Scenario::load("urgent_merge").unwrap();
+        let s = Scenario::from_toml(urgent(), "fixture").unwrap();
         assert_eq!(s.instance(None), s);
         let a = s.instantiate(42);
         assert_eq!(a, s.instantiate(42));
@@ -511,7 +544,7 @@ mod tests {
 
     #[test]
     fn a_draw_does_not_depend_on_which_other_values_are_randomised() {
-        let s = Scenario::load("urgent_merge").unwrap();
+        let s = Scenario::from_toml(urgent(), "fixture").unwrap();
         let mut fewer = s.clone();
         fewer.randomise.mu = None;
         let (a, b) = (s.instantiate(9), fewer.instantiate(9));

@@ -272,7 +272,7 @@ impl World {
         let report_every = (total / 100).max(1);
         while self.step_index < total {
             self.step()?;
-            if self.step_index % report_every == 0 {
+            if self.step_index.is_multiple_of(report_every) {
                 progress(self.step_index as f64 / total as f64);
             }
         }
@@ -285,7 +285,7 @@ impl World {
         // 1. V2V delivery.
         self.bus.deliver(t_s);
         // 2. Planning, by id.
-        if self.step_index % self.steps_per_plan == 0 {
+        if self.step_index.is_multiple_of(self.steps_per_plan) {
             self.plan_all(t_s)?;
         }
         // 3.–4. Tracking, forces.
@@ -305,8 +305,8 @@ impl World {
         self.step_index += 1;
         let t_s = self.time_s();
         // 5. Safety checks.
-        let need_log = self.step_index % self.steps_per_log == 0;
-        let need_safety = self.step_index % self.steps_per_safety == 0;
+        let need_log = self.step_index.is_multiple_of(self.steps_per_log);
+        let need_safety = self.step_index.is_multiple_of(self.steps_per_safety);
         if need_safety || need_log {
             let kins: Vec<Kinematics> = self
                 .agents
@@ -477,7 +477,7 @@ impl World {
                     .map_err(rec)?;
                 self.events.push(text);
             }
-            if self.step_index % self.steps_per_field == 0 && self.recorder.is_enabled() {
+            if self.step_index.is_multiple_of(self.steps_per_field) && self.recorder.is_enabled() {
                 log_field(&mut self.recorder, planner, &request, &agent.spec.name)?;
             }
             agent.path = plan.path.clone();
@@ -513,7 +513,9 @@ impl World {
                     "t = {t_s:.2} s: {} crossed the lane divider at x = {:.1} m",
                     agent.spec.name, k.x_m
                 );
-                self.recorder.log_event(&text, EventLevel::Info).map_err(rec)?;
+                self.recorder
+                    .log_event(&text, EventLevel::Info)
+                    .map_err(rec)?;
                 self.events.push(text);
             }
             let planned_speed_mps = planned_speed_at(&agent.path, t_s).unwrap_or(k.speed_mps);

@@ -254,8 +254,7 @@ fn simulate(
     };
     // With a seed, the instance drawn from the scenario's [randomise] ranges (as a sweep runs it).
     let instance = scenario.instance(seed);
-    let world =
-        World::new(instance.sim, &instance.vehicles, &options, recorder).map_err(input)?;
+    let world = World::new(instance.sim, &instance.vehicles, &options, recorder).map_err(input)?;
     let started = Instant::now();
     let progress = progress_printer(show_progress, format!("{} {label}", scenario.name));
     let outcome = world.run(progress).map_err(run_failure)?;
@@ -540,7 +539,8 @@ fn parse_threads(text: &str) -> Result<usize, String> {
 }
 
 fn parse_shard(text: &str) -> Result<mergesim::sweep::Shard, String> {
-    text.parse().map_err(|e: mergesim::sweep::ShardError| e.to_string())
+    text.parse()
+        .map_err(|e: mergesim::sweep::ShardError| e.to_string())
 }
 
 fn sweep_failure(e: mergesim::sweep::SweepError) -> Failure {
@@ -559,7 +559,10 @@ fn write_output(path: &Path, text: &str) -> Result<(), Failure> {
 fn cmd_sweep(args: &SweepArgs) -> Result<(), Failure> {
     use mergesim::sweep::{Shard, SweepOptions, SweepPlan, run_sweep};
     let scenario = Scenario::load(&args.scenario).map_err(input)?;
-    for (path, what) in [(args.json.as_deref(), "--json"), (args.jsonl.as_deref(), "--jsonl")] {
+    for (path, what) in [
+        (args.json.as_deref(), "--json"),
+        (args.jsonl.as_deref(), "--jsonl"),
+    ] {
         if let Some(path) = path {
             check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
         }
