@@ -6,6 +6,7 @@
 //! [`scenarios`] (scenario files).
 
 pub mod output;
+pub mod plots;
 pub mod summary;
 pub mod sweep;
 

@@ -104,6 +104,8 @@ pub struct RunMetrics {
     pub peak_sideslip_rad: f64,
     /// Largest |yaw| of any vehicle (rad).
     pub peak_yaw_rad: f64,
+    /// Lowest speed of any vehicle (m/s): how hard somebody had to brake.
+    pub min_speed_mps: f64,
     /// Yaw-rate sign changes, summed over the vehicles.
     pub yaw_rate_sign_changes: u64,
     /// Planner cycles that fell back.
@@ -127,6 +129,11 @@ impl RunMetrics {
             peak_yaw_rate_radps: peak(|v| v.max_abs_yaw_rate_radps),
             peak_sideslip_rad: peak(|v| v.max_abs_sideslip_rad),
             peak_yaw_rad: peak(|v| v.max_abs_yaw_rad),
+            min_speed_mps: summary
+                .vehicles
+                .iter()
+                .map(|v| v.min_speed_mps)
+                .fold(f64::INFINITY, f64::min),
             yaw_rate_sign_changes: summary
                 .vehicles
                 .iter()
@@ -216,6 +223,8 @@ pub struct SweepSummary {
     pub mean_peak_sideslip_rad: Option<f64>,
     /// Mean over completed runs of the largest |yaw| of any vehicle (rad).
     pub mean_peak_yaw_rad: Option<f64>,
+    /// Mean over completed runs of the lowest speed of any vehicle (m/s).
+    pub mean_min_speed_mps: Option<f64>,
     /// Planner fallback cycles, summed over the completed runs.
     pub fallbacks: u64,
     /// Completed runs with at least one fallback.
@@ -257,7 +266,12 @@ impl SweepIdentity {
 
 impl SweepSummary {
     /// The aggregate of `rows` (the instances `shard.instances(total_runs)`, in instance order).
-    pub fn from_rows(identity: &SweepIdentity, shard: Shard, rows: Vec<RunRow>, wall_time_s: f64) -> Self {
+    pub fn from_rows(
+        identity: &SweepIdentity,
+        shard: Shard,
+        rows: Vec<RunRow>,
+        wall_time_s: f64,
+    ) -> Self {
         let range = shard.instances(identity.total_runs);
         let done: Vec<&RunMetrics> = rows.iter().filter_map(|r| r.metrics.as_ref()).collect();
         let completed = done.len() as u64;
@@ -270,8 +284,12 @@ impl SweepSummary {
             values.sort_by(f64::total_cmp);
             nearest_rank_percentile(&values, 5.0).filter(|v| v.is_finite())
         };
-        let mean_of = |f: &dyn Fn(&RunMetrics) -> f64| mean(&done.iter().map(|m| f(m)).collect::<Vec<_>>());
-        let panicked = rows.iter().filter(|r| r.status == RunStatus::Panicked).count() as u64;
+        let mean_of =
+            |f: &dyn Fn(&RunMetrics) -> f64| mean(&done.iter().map(|m| f(m)).collect::<Vec<_>>());
+        let panicked = rows
+            .iter()
+            .filter(|r| r.status == RunStatus::Panicked)
+            .count() as u64;
         SweepSummary {
             scenario: identity.scenario.clone(),
             scenario_fingerprint: identity.scenario_fingerprint.clone(),
@@ -295,6 +313,7 @@ impl SweepSummary {
             mean_peak_yaw_rate_radps: mean_of(&|m| m.peak_yaw_rate_radps),
             mean_peak_sideslip_rad: mean_of(&|m| m.peak_sideslip_rad),
             mean_peak_yaw_rad: mean_of(&|m| m.peak_yaw_rad),
+            mean_min_speed_mps: mean_of(&|m| m.min_speed_mps),
             fallbacks: done.iter().map(|m| m.fallbacks).sum(),
             runs_with_fallbacks: count(&|m| m.fallbacks > 0),
             wall_time_s,
@@ -316,10 +335,12 @@ impl SweepSummary {
     /// A few lines for the terminal.
     pub fn table(&self) -> String {
         let opt = |v: Option<f64>, digits: usize| {
-            v.map(|x| format!("{x:.digits$}")).unwrap_or_else(|| "-".into())
+            v.map(|x| format!("{x:.digits$}"))
+                .unwrap_or_else(|| "-".into())
         };
         let ci = |v: Option<[f64; 2]>| {
-            v.map(|[l, h]| format!("[{l:.4}, {h:.4}]")).unwrap_or_else(|| "-".into())
+            v.map(|[l, h]| format!("[{l:.4}, {h:.4}]"))
+                .unwrap_or_else(|| "-".into())
         };
         let per_s = if self.wall_time_s > 0.0 {
             self.runs as f64 / self.wall_time_s
@@ -332,7 +353,7 @@ impl SweepSummary {
              collisions {}  rate {}  95% CI {}\n\
              near misses {}  rate {}  95% CI {}\n\
              p5 min TTC {} s  p5 min gap {} m\n\
-             mean peak |r| {} rad/s  mean peak |β| {} rad  mean peak |ψ| {} rad\n\
+             mean peak |r| {} rad/s  mean peak |β| {} rad  mean peak |ψ| {} rad  mean min v {} m/s\n\
              fallback cycles {} (in {} runs)\n",
             self.scenario,
             self.planner,
@@ -358,6 +379,7 @@ impl SweepSummary {
             opt(self.mean_peak_yaw_rate_radps, 4),
             opt(self.mean_peak_sideslip_rad, 4),
             opt(self.mean_peak_yaw_rad, 4),
+            opt(self.mean_min_speed_mps, 2),
             self.fallbacks,
             self.runs_with_fallbacks,
         )
@@ -399,7 +421,8 @@ pub fn planner_label(scenario: &Scenario, planner: Option<PlannerKind>) -> Strin
         .iter()
         .filter_map(|v| match v.driver {
             sim::Driver::Planner(kind) => Some(kind.name()),
-            sim::Driver::LaneKeeping => None,
+            // Lane keeping (and any other non-planner driver, e.g. a future IDM).
+            _ => None,
         })
         .collect();
     kinds.sort_unstable();
@@ -420,7 +443,12 @@ pub fn simulate_instance(plan: &SweepPlan, seed: u64) -> Result<RunSummary, sim:
         keep_time_series: false,
     };
     let started = Instant::now();
-    let world = World::new(instance.sim, &instance.vehicles, &options, Recorder::disabled())?;
+    let world = World::new(
+        instance.sim,
+        &instance.vehicles,
+        &options,
+        Recorder::disabled(),
+    )?;
     let outcome = world.run(|_| {})?;
     let label = planner_label(&plan.scenario, plan.planner);
     Ok(RunSummary::new(
@@ -457,7 +485,9 @@ where
     F: Fn(u64) -> Result<RunMetrics, String> + Sync,
 {
     if plan.runs == 0 {
-        return Err(SweepError::Invalid("runs = 0: a sweep needs at least 1 run".into()));
+        return Err(SweepError::Invalid(
+            "runs = 0: a sweep needs at least 1 run".into(),
+        ));
     }
     if options.threads == Some(0) {
         return Err(SweepError::Invalid("threads = 0: need at least 1".into()));
@@ -533,14 +563,21 @@ pub fn merge_shards(parts: Vec<(String, SweepSummary)>) -> Result<SweepSummary, 
     };
     let identity = first.identity();
     let count = first.shard.count;
-    let mut seen: Vec<Option<&str>> = vec![None; usize::try_from(count).unwrap_or(usize::MAX).min(1 << 20)];
+    let mut seen: Vec<Option<&str>> =
+        vec![None; usize::try_from(count).unwrap_or(usize::MAX).min(1 << 20)];
     if seen.len() as u64 != count {
-        return Err(SweepError::Invalid(format!("{first_origin}: shard count {count} is too large")));
+        return Err(SweepError::Invalid(format!(
+            "{first_origin}: shard count {count} is too large"
+        )));
     }
     for (origin, part) in &parts {
         let other = part.identity();
         let fields = [
-            ("scenario", identity.scenario.clone(), other.scenario.clone()),
+            (
+                "scenario",
+                identity.scenario.clone(),
+                other.scenario.clone(),
+            ),
             (
                 "scenario_fingerprint",
                 identity.scenario_fingerprint.clone(),
@@ -548,8 +585,16 @@ pub fn merge_shards(parts: Vec<(String, SweepSummary)>) -> Result<SweepSummary, 
             ),
             ("planner", identity.planner.clone(), other.planner.clone()),
             ("seed", identity.seed.to_string(), other.seed.to_string()),
-            ("total_runs", identity.total_runs.to_string(), other.total_runs.to_string()),
-            ("shard count", count.to_string(), part.shard.count.to_string()),
+            (
+                "total_runs",
+                identity.total_runs.to_string(),
+                other.total_runs.to_string(),
+            ),
+            (
+                "shard count",
+                count.to_string(),
+                part.shard.count.to_string(),
+            ),
         ];
         for (name, expected, found) in fields {
             if expected != found {
@@ -568,13 +613,19 @@ pub fn merge_shards(parts: Vec<(String, SweepSummary)>) -> Result<SweepSummary, 
         *slot = Some(origin.as_str());
         let range = part.shard.instances(part.total_runs);
         let instances: Vec<u64> = part.samples.iter().map(|r| r.instance).collect();
-        if instances != range.clone().collect::<Vec<_>>() || part.instances != [range.start, range.end] {
+        if instances != range.clone().collect::<Vec<_>>()
+            || part.instances != [range.start, range.end]
+        {
             return Err(SweepError::Invalid(format!(
                 "{origin}: shard {} must hold instances {}..{} in order",
                 part.shard, range.start, range.end
             )));
         }
-        if let Some(bad) = part.samples.iter().find(|r| r.seed != instance_seed(part.seed, r.instance)) {
+        if let Some(bad) = part
+            .samples
+            .iter()
+            .find(|r| r.seed != instance_seed(part.seed, r.instance))
+        {
             return Err(SweepError::Invalid(format!(
                 "{origin}: instance {} has seed {}, not the derived {}",
                 bad.instance,
@@ -590,13 +641,24 @@ pub fn merge_shards(parts: Vec<(String, SweepSummary)>) -> Result<SweepSummary, 
         .map(|(i, _)| format!("{i}/{count}"))
         .collect();
     if !missing.is_empty() {
-        return Err(SweepError::Invalid(format!("missing shards: {}", missing.join(", "))));
+        return Err(SweepError::Invalid(format!(
+            "missing shards: {}",
+            missing.join(", ")
+        )));
     }
     let mut ordered: Vec<&SweepSummary> = parts.iter().map(|(_, p)| p).collect();
     ordered.sort_by_key(|p| p.shard.index);
     let wall_time_s = ordered.iter().map(|p| p.wall_time_s).sum();
-    let rows = ordered.into_iter().flat_map(|p| p.samples.iter().cloned()).collect();
-    Ok(SweepSummary::from_rows(&identity, Shard::WHOLE, rows, wall_time_s))
+    let rows = ordered
+        .into_iter()
+        .flat_map(|p| p.samples.iter().cloned())
+        .collect();
+    Ok(SweepSummary::from_rows(
+        &identity,
+        Shard::WHOLE,
+        rows,
+        wall_time_s,
+    ))
 }
 
 #[cfg(test)]
@@ -622,14 +684,19 @@ mod tests {
         }
         let x = (seed % 1000) as f64 / 1000.0;
         Ok(RunMetrics {
-            collisions: u64::from(seed % 7 == 0),
-            near_miss: seed % 7 != 0 && x < 0.2,
-            min_ttc_s: if seed % 5 == 0 { None } else { Some(x * 4.0) },
+            collisions: u64::from(seed.is_multiple_of(7)),
+            near_miss: !seed.is_multiple_of(7) && x < 0.2,
+            min_ttc_s: if seed.is_multiple_of(5) {
+                None
+            } else {
+                Some(x * 4.0)
+            },
             min_gap_m: Some(x * 3.0),
             tet_s: 0.0,
             peak_yaw_rate_radps: x,
             peak_sideslip_rad: x / 10.0,
             peak_yaw_rad: x / 5.0,
+            min_speed_mps: 10.0 + x,
             yaw_rate_sign_changes: seed % 3,
             fallbacks: seed % 2,
             plans: 10,
@@ -638,26 +705,50 @@ mod tests {
 
     #[test]
     fn aggregate_counts_follow_the_rows_and_failures_are_kept() {
-        let outcome = run_sweep_with(&plan(60, Shard::WHOLE), &SweepOptions { threads: Some(2) }, &|| {}, fake).unwrap();
+        let outcome = run_sweep_with(
+            &plan(60, Shard::WHOLE),
+            &SweepOptions { threads: Some(2) },
+            &|| {},
+            fake,
+        )
+        .unwrap();
         let s = &outcome.summary;
         assert_eq!(s.runs, 60);
-        assert_eq!(s.samples.iter().map(|r| r.instance).collect::<Vec<_>>(), (0..60).collect::<Vec<_>>());
+        assert_eq!(
+            s.samples.iter().map(|r| r.instance).collect::<Vec<_>>(),
+            (0..60).collect::<Vec<_>>()
+        );
         let seeds: Vec<u64> = (0..60).map(|i| instance_seed(77, i)).collect();
         assert_eq!(s.samples.iter().map(|r| r.seed).collect::<Vec<_>>(), seeds);
         let diverged = seeds.iter().filter(|s| *s % 11 == 0).count() as u64;
         let panicked = seeds.iter().filter(|s| *s % 11 == 1).count() as u64;
-        assert!(panicked > 0 && diverged > 0, "choose another seed for the test");
+        assert!(
+            panicked > 0 && diverged > 0,
+            "choose another seed for the test"
+        );
         assert_eq!(s.panicked, panicked);
         assert_eq!(s.diverged, diverged + panicked);
         assert_eq!(s.completed, 60 - diverged - panicked);
         let ok: Vec<u64> = seeds.iter().copied().filter(|s| s % 11 > 1).collect();
-        assert_eq!(s.collisions, ok.iter().filter(|s| *s % 7 == 0).count() as u64);
-        assert_eq!(s.collision_rate, Some(s.collisions as f64 / s.completed as f64));
+        assert_eq!(
+            s.collisions,
+            ok.iter().filter(|s| *s % 7 == 0).count() as u64
+        );
+        assert_eq!(
+            s.collision_rate,
+            Some(s.collisions as f64 / s.completed as f64)
+        );
         assert_eq!(s.fallbacks, ok.iter().map(|s| s % 2).sum::<u64>());
         // p5 by brute force: the smallest value with at least 5 % of the runs at or below it.
         let ttc: Vec<f64> = ok
             .iter()
-            .map(|s| if s % 5 == 0 { f64::INFINITY } else { (s % 1000) as f64 / 1000.0 * 4.0 })
+            .map(|s| {
+                if s % 5 == 0 {
+                    f64::INFINITY
+                } else {
+                    (s % 1000) as f64 / 1000.0 * 4.0
+                }
+            })
             .collect();
         let brute = ttc
             .iter()
@@ -665,25 +756,48 @@ mod tests {
             .filter(|&c| ttc.iter().filter(|&&v| v <= c).count() as f64 >= 0.05 * ttc.len() as f64)
             .fold(f64::INFINITY, f64::min);
         assert_eq!(s.min_ttc_s_p5, Some(brute));
-        let failed = s.samples.iter().find(|r| r.status == RunStatus::Panicked).unwrap();
-        assert!(failed.error.as_deref().unwrap().starts_with("panic: test panic"));
+        let failed = s
+            .samples
+            .iter()
+            .find(|r| r.status == RunStatus::Panicked)
+            .unwrap();
+        assert!(
+            failed
+                .error
+                .as_deref()
+                .unwrap()
+                .starts_with("panic: test panic")
+        );
         assert!(failed.metrics.is_none());
     }
 
     #[test]
     fn merged_shards_equal_the_unsharded_sweep_whatever_the_threads() {
         let options = SweepOptions { threads: Some(1) };
-        let mut whole = run_sweep_with(&plan(23, Shard::WHOLE), &options, &|| {}, fake).unwrap().summary;
+        let mut whole = run_sweep_with(&plan(23, Shard::WHOLE), &options, &|| {}, fake)
+            .unwrap()
+            .summary;
         let mut parts = Vec::new();
         for index in [2, 0, 3, 1] {
             let shard = Shard::new(index, 4, "t").unwrap();
-            let part = run_sweep_with(&plan(23, shard), &SweepOptions { threads: Some(2) }, &|| {}, fake).unwrap();
+            let part = run_sweep_with(
+                &plan(23, shard),
+                &SweepOptions { threads: Some(2) },
+                &|| {},
+                fake,
+            )
+            .unwrap();
             parts.push((format!("shard{index}.json"), part.summary));
         }
         // Through JSON, as merge-results reads them.
         let parts: Vec<(String, SweepSummary)> = parts
             .into_iter()
-            .map(|(o, p)| (o, serde_json::from_str(&serde_json::to_string(&p).unwrap()).unwrap()))
+            .map(|(o, p)| {
+                (
+                    o,
+                    serde_json::from_str(&serde_json::to_string(&p).unwrap()).unwrap(),
+                )
+            })
             .collect();
         let mut merged = merge_shards(parts.clone()).unwrap();
         whole.wall_time_s = 0.0;
@@ -697,7 +811,12 @@ mod tests {
         assert!(err.contains("missing shards: 1/4"), "{err}");
         let mut twice = parts.clone();
         twice.push(("again.json".into(), parts[0].1.clone()));
-        assert!(merge_shards(twice).unwrap_err().to_string().contains("again.json"));
+        assert!(
+            merge_shards(twice)
+                .unwrap_err()
+                .to_string()
+                .contains("again.json")
+        );
         let mut foreign = parts.clone();
         foreign[1].1.seed = 78;
         let err = merge_shards(foreign).unwrap_err().to_string();
@@ -706,18 +825,35 @@ mod tests {
 
     #[test]
     fn zero_runs_and_zero_threads_are_refused() {
-        let err = run_sweep_with(&plan(0, Shard::WHOLE), &SweepOptions::default(), &|| {}, fake).unwrap_err();
+        let err = run_sweep_with(
+            &plan(0, Shard::WHOLE),
+            &SweepOptions::default(),
+            &|| {},
+            fake,
+        )
+        .unwrap_err();
         assert!(err.to_string().contains("runs = 0"));
-        let err = run_sweep_with(&plan(3, Shard::WHOLE), &SweepOptions { threads: Some(0) }, &|| {}, fake).unwrap_err();
+        let err = run_sweep_with(
+            &plan(3, Shard::WHOLE),
+            &SweepOptions { threads: Some(0) },
+            &|| {},
+            fake,
+        )
+        .unwrap_err();
         assert!(err.to_string().contains("threads = 0"));
     }
 
     #[test]
     fn empty_shard_is_a_valid_part() {
         // 2 runs in 4 shards: shard 0/4 holds nothing.
-        let part = run_sweep_with(&plan(2, Shard::new(0, 4, "t").unwrap()), &SweepOptions::default(), &|| {}, fake)
-            .unwrap()
-            .summary;
+        let part = run_sweep_with(
+            &plan(2, Shard::new(0, 4, "t").unwrap()),
+            &SweepOptions::default(),
+            &|| {},
+            fake,
+        )
+        .unwrap()
+        .summary;
         assert_eq!((part.runs, part.instances), (0, [0, 0]));
         assert_eq!(part.collision_rate, None);
         assert_eq!(part.collision_rate_ci95, None);

@@ -107,11 +107,11 @@ pub struct PlannerParams {
     /// w3, weight of the interaction term Σ ln U_SLP^i (0 turns PF-ISO into PF-SP).
     pub interaction_weight: f64,
     /// Floor of the interaction term, ln(floor + Σ U_OB) (same unit as A_obs). The term acts
-    /// where the others' fields exceed it and fades below: with the default (= the field's
-    /// fraction at D_min) a vehicle further than D_min ahead or behind, or a lane away, leaves
-    /// the speeds alone. The paper's ε (far smaller) would make ln U pull hardest near the ε
-    /// contour, i.e. at 3–4 σ_x, so vehicles at a safe following distance keep pushing each
-    /// other's speeds away from their targets.
+    /// where the others' fields exceed it and fades below: with the default (0.02, a fifth of
+    /// the field's fraction 0.1 at D_min) a vehicle further than about 1.3 D_min ahead or
+    /// behind, or a lane away, leaves the speeds alone. The paper's ε (far smaller) would make
+    /// ln U pull hardest near the ε contour, i.e. at 3–4 σ_x, so vehicles at a safe following
+    /// distance keep pushing each other's speeds away from their targets.
     pub interaction_floor: f64,
     /// In the interaction term, a vehicle behind the planning vehicle counts only within the
     /// contact distance (l + l_o)/2 ahead of it, while a vehicle ahead keeps its full
@@ -164,14 +164,29 @@ impl Default for PlannerParams {
             edge_gain_m2: 0.01,
             edge_clamp_distance_m: 0.1,
             obstacle_amplitude: 1.0,
-            obstacle_epsilon: 0.002,
+            // Sharper lateral decay than ε = 0.002 (σ_y 0.87 m instead of 0.99 m): a vehicle one
+            // lane away (3.5 m) then adds only 3e-4 to the field, so two cars side by side in
+            // their own lanes barely touch each other's interaction term (Eq. 10). With 0.002 the
+            // tiny cross-lane term tipped the urgent merge into the ego yielding and the obstacle
+            // accelerating, well before either car had moved laterally (docs/reproduction.md).
+            obstacle_epsilon: 3e-4,
             obstacle_lateral_safety_m: 3.5,
             obstacle_fraction_at_min_distance: 0.1,
-            obstacle_time_gap_s: 1.0,
+            // Between the 2- and 3-second following rules of driver manuals: the follower's
+            // D_min is (l + l_o)/2 + 2.5 s · v_f (+ the braking term), 42 m at 15 m/s. It sets
+            // how much room the obstacle opens for the merging ego in PF-ISO. 3 s opens more
+            // (the obstacle slows to ≈ 13.3 instead of ≈ 13.9 m/s) but, with the 8 s horizon,
+            // makes a leader without `interaction_rear_only` slow down to let a constant-
+            // velocity follower "pass through" it instead of speeding up (planner test
+            // `a_follower_does_not_push_the_leader_...`); see docs/reproduction.md.
+            obstacle_time_gap_s: 2.5,
             ego_mass_factor: 1.0,
             other_mass_factor: 1.0,
             waypoint_count: 20,
-            step_time_s: 0.25,
+            // N · Δt_plan = 8 s of shared local path (160 m at 20 m/s): at t ≈ 3 s the ego's
+            // SLP already reaches the merge section, which is what lets the obstacle start
+            // slowing then (paper: 3.1 s); with 5 s it could not react before t ≈ 6 s.
+            step_time_s: 0.4,
             min_step_m: 1.0,
             max_substep_m: 1.0,
             predict_obstacles_in_path: false,
@@ -184,8 +199,14 @@ impl Default for PlannerParams {
             min_speed_mps: 0.5,
             travel_time_weight: 1.0,
             speed_deviation_weight: 1.0,
-            interaction_weight: 10.0,
-            interaction_floor: 0.1,
+            // w3 / w2 = 15 with the floor below: the obstacle gives up ≈ 2 m/s to open the
+            // gap; from w3 ≈ 25 (or a floor of 0.01) the non-convex term starts to tip the
+            // perturbed merges into the ego yielding instead (docs/reproduction.md).
+            interaction_weight: 15.0,
+            // The term acts out to U ≈ 0.02, about 1.3 D_min (exp(−q) = 0.02 ⇔ q = 3.9 against
+            // q = 2.3 at D_min for the default fraction 0.1): a little beyond the safety
+            // distance, still fading a lane away (see `obstacle_epsilon`).
+            interaction_floor: 0.02,
             interaction_rear_only: true,
             interaction_slows_only: false,
             trust_region_mps: 2.0,

@@ -4,9 +4,15 @@
 /// (name, TOML text) of every built-in scenario.
 pub const BUILTINS: &[(&str, &str)] = &[
     ("urgent_merge", include_str!("../builtin/urgent_merge.toml")),
-    ("relaxed_merge", include_str!("../builtin/relaxed_merge.toml")),
+    (
+        "relaxed_merge",
+        include_str!("../builtin/relaxed_merge.toml"),
+    ),
     ("dense_merge", include_str!("../builtin/dense_merge.toml")),
-    ("mixed_traffic", include_str!("../builtin/mixed_traffic.toml")),
+    (
+        "mixed_traffic",
+        include_str!("../builtin/mixed_traffic.toml"),
+    ),
     ("degraded_v2v", include_str!("../builtin/degraded_v2v.toml")),
     ("wet_road", include_str!("../builtin/wet_road.toml")),
     (

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
 
 use crate::error::SimError;
+use crate::idm::IdmParams;
 use crate::safety::SafetyParams;
 use crate::v2v::V2vParams;
 
@@ -36,6 +37,8 @@ pub struct SimConfig {
     pub tracker: TrackerParams,
     /// Collision, gap and TTC thresholds.
     pub safety: SafetyParams,
+    /// Intelligent Driver Model of the human-driven (`driver = "idm"`) vehicles.
+    pub idm: IdmParams,
 }
 
 impl Default for SimConfig {
@@ -53,6 +56,7 @@ impl Default for SimConfig {
             planner: PlannerParams::default(),
             tracker: TrackerParams::default(),
             safety: SafetyParams::default(),
+            idm: IdmParams::default(),
         }
     }
 }
@@ -96,6 +100,7 @@ impl SimConfig {
             }
         }
         self.v2v.validate()?;
+        self.idm.validate()?;
         self.planner
             .validate()
             .map_err(|e| SimError::InvalidScenario(e.to_string()))?;
@@ -109,8 +114,12 @@ impl SimConfig {
 pub enum Driver {
     /// A potential-field planner of the given kind.
     Planner(PlannerKind),
-    /// No planner: holds its lane centre and initial speed (for deliberately unsafe tests).
+    /// No planner: holds its lane centre and target speed, blind to others (for deliberately
+    /// unsafe tests).
     LaneKeeping,
+    /// A human driver: Intelligent Driver Model car following (Treiber et al. 2000) with lane
+    /// keeping; never changes lanes, never connected.
+    Idm,
 }
 
 /// One vehicle to spawn.

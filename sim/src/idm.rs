@@ -61,12 +61,22 @@ impl IdmParams {
     pub fn validate(&self) -> Result<(), SimError> {
         let fields = [
             ("max_accel_mps2", self.max_accel_mps2, 0.01, 20.0),
-            ("comfortable_decel_mps2", self.comfortable_decel_mps2, 0.01, 20.0),
+            (
+                "comfortable_decel_mps2",
+                self.comfortable_decel_mps2,
+                0.01,
+                20.0,
+            ),
             ("time_headway_s", self.time_headway_s, 0.0, 10.0),
             ("min_gap_m", self.min_gap_m, 0.0, 50.0),
             ("accel_exponent", self.accel_exponent, 0.1, 20.0),
             ("max_decel_mps2", self.max_decel_mps2, 0.1, 30.0),
-            ("corridor_half_width_m", self.corridor_half_width_m, 0.1, 10.0),
+            (
+                "corridor_half_width_m",
+                self.corridor_half_width_m,
+                0.1,
+                10.0,
+            ),
         ];
         for (name, value, lo, hi) in fields {
             if !(value.is_finite() && value >= lo && value <= hi) {
@@ -217,8 +227,14 @@ mod tests {
     #[test]
     fn braking_is_bounded_and_overlap_brakes_fully() {
         let p = IdmParams::default();
-        assert_eq!(idm_acceleration(&p, 20.0, 20.0, Some(&leader(0.5, 0.0))), -p.max_decel_mps2);
-        assert_eq!(idm_acceleration(&p, 5.0, 20.0, Some(&leader(-1.0, 5.0))), -p.max_decel_mps2);
+        assert_eq!(
+            idm_acceleration(&p, 20.0, 20.0, Some(&leader(0.5, 0.0))),
+            -p.max_decel_mps2
+        );
+        assert_eq!(
+            idm_acceleration(&p, 5.0, 20.0, Some(&leader(-1.0, 5.0))),
+            -p.max_decel_mps2
+        );
     }
 
     #[test]
@@ -260,7 +276,10 @@ mod tests {
             ..IdmParams::default()
         };
         let err = p.validate().unwrap_err().to_string();
-        assert!(err.contains("idm.time_headway_s") && err.contains("-1"), "{err}");
+        assert!(
+            err.contains("idm.time_headway_s") && err.contains("-1"),
+            "{err}"
+        );
         IdmParams::default().validate().unwrap();
     }
 }

@@ -20,6 +20,7 @@ use vehicles::{Kinematics, PhysicsWorld, Tracker, Vehicle, VehicleParams};
 
 use crate::config::{Driver, SimConfig, VehicleSpec};
 use crate::error::SimError;
+use crate::idm::{RoadUser, find_leader, idm_acceleration, speed_after_distance};
 use crate::metrics::{MetricsSample, VehicleMetrics, VehicleMetricsSummary};
 use crate::recording::{EventLevel, Recorder};
 use crate::safety::{BodyState, SafetyMonitor, SafetySummary};
@@ -239,7 +240,7 @@ impl World {
                     )?,
                 )
             }
-            Driver::LaneKeeping => None,
+            Driver::LaneKeeping | Driver::Idm => None,
         };
         let tracker = Tracker::new(config.tracker.clone(), &params);
         Ok(Agent {
@@ -439,6 +440,32 @@ impl World {
                     shape: other.shape,
                 })
                 .collect();
+            if self.agents[index].spec.driver == Driver::Idm {
+                let users: Vec<RoadUser> = self
+                    .agents
+                    .iter()
+                    .zip(&kins)
+                    .map(|(a, k)| RoadUser {
+                        x_m: k.x_m,
+                        y_m: k.y_m,
+                        speed_mps: k.speed_mps,
+                        length_m: a.shape.length_m,
+                    })
+                    .collect();
+                let leader = find_leader(&self.config.idm, &users, index);
+                let agent = &mut self.agents[index];
+                let v = kins[index].speed_mps;
+                let accel_mps2 = idm_acceleration(
+                    &self.config.idm,
+                    v,
+                    agent.spec.target_speed_mps,
+                    leader.as_ref(),
+                );
+                agent.path = lane_path(&self.config, &agent.spec, &kins[index], t_s, |d| {
+                    speed_after_distance(v, accel_mps2, d)
+                });
+                continue;
+            }
             let agent = &mut self.agents[index];
             let Some(planner) = agent.planner.as_mut() else {
                 agent.path = lane_keeping_path(&self.config, &agent.spec, &kins[index], t_s);
@@ -676,19 +703,40 @@ fn lane_keeping_path(
     k: &Kinematics,
     t_s: f64,
 ) -> Vec<PathPoint> {
-    let y_m = config.road.lane_center_y_m(spec.lane) + spec.y_offset_m;
     let v = spec.target_speed_mps;
-    (0..=10)
-        .map(|i| {
-            let ahead_m = 10.0 * i as f64;
-            PathPoint {
-                x_m: k.x_m + ahead_m,
-                y_m,
-                speed_mps: v,
-                t_s: t_s + ahead_m / v.max(1.0),
-            }
-        })
-        .collect()
+    lane_path(config, spec, k, t_s, |_| v)
+}
+
+/// A straight path along the spawn lane's centre, 50 m ahead in 2.5 m steps, with the speed
+/// `speed_at(distance ahead)` and times integrated from the mean speed of each step.
+fn lane_path(
+    config: &SimConfig,
+    spec: &VehicleSpec,
+    k: &Kinematics,
+    t_s: f64,
+    speed_at: impl Fn(f64) -> f64,
+) -> Vec<PathPoint> {
+    const STEP_M: f64 = 2.5;
+    const POINTS: usize = 21;
+    let y_m = config.road.lane_center_y_m(spec.lane) + spec.y_offset_m;
+    let mut points = Vec::with_capacity(POINTS);
+    let mut t = t_s;
+    let mut previous_speed = speed_at(0.0);
+    for i in 0..POINTS {
+        let ahead_m = STEP_M * i as f64;
+        let speed_mps = speed_at(ahead_m);
+        if i > 0 {
+            t += STEP_M / (0.5 * (previous_speed + speed_mps)).max(0.1);
+        }
+        previous_speed = speed_mps;
+        points.push(PathPoint {
+            x_m: k.x_m + ahead_m,
+            y_m,
+            speed_mps,
+            t_s: t,
+        });
+    }
+    points
 }
 
 /// Samples the ego's potential field on a window around it and logs it as an image.

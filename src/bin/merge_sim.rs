@@ -12,11 +12,33 @@ use anyhow::{Context, anyhow};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use mergesim::output::{check_output_path, write_atomically};
 use mergesim::summary::RunSummary;
+use mergesim::sweep::planner_label;
 use planner::PlannerKind;
 use scenarios::Scenario;
 use sim::recording::Recorder;
 use sim::{RunOptions, RunOutcome, TimeSeriesRow, World};
 use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
+
+/// `print!` that ends the process quietly when stdout is closed (output piped into `head`)
+/// instead of panicking.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = write!(std::io::stdout(), $($arg)*) {
+            if e.kind() == std::io::ErrorKind::BrokenPipe {
+                std::process::exit(0);
+            }
+        }
+    }};
+}
+
+/// `println!` with the same treatment of a closed stdout as [`out!`].
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        out!($($arg)*);
+        out!("\n");
+    }};
+}
 
 /// Cooperative merge simulator: potential-field planners with interactive speed optimisation
 /// (Lin et al.) on physics-based Rapier vehicles.
@@ -100,6 +122,11 @@ struct CompareArgs {
     /// Write the JSON summaries (an array) here.
     #[arg(long, value_name = "PATH")]
     json: Option<PathBuf>,
+    /// Write figures into this existing folder: paths.png (both vehicles' paths per planner,
+    /// the paper's Fig. 3), states_<vehicle>.png (sideslip, yaw, yaw rate, speed over time per
+    /// planner; states_obstacle.png is the paper's Fig. 4) and time_series.csv (their data).
+    #[arg(long, value_name = "DIR")]
+    plots: Option<PathBuf>,
 }
 
 #[derive(Copy, Clone, Debug, ValueEnum)]
@@ -186,27 +213,6 @@ fn main() -> ExitCode {
             eprintln!("error: {e:#}");
             ExitCode::from(1)
         }
-    }
-}
-
-/// The planner name of a run: the override, or the scenario's single kind, or `mixed`.
-fn planner_label(scenario: &Scenario, planner: Option<PlannerKind>) -> String {
-    if let Some(kind) = planner {
-        return kind.name().to_string();
-    }
-    let mut kinds: Vec<&str> = scenario
-        .vehicles
-        .iter()
-        .filter_map(|v| match v.driver {
-            sim::Driver::Planner(kind) => Some(kind.name()),
-            sim::Driver::LaneKeeping => None,
-        })
-        .collect();
-    kinds.dedup();
-    match kinds.as_slice() {
-        [] => "none".into(),
-        [one] => (*one).to_string(),
-        _ => "mixed".into(),
     }
 }
 
@@ -311,12 +317,12 @@ fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
             .map_err(run_failure)?;
     }
     if !args.quiet {
-        print!("{}", finished.summary.table());
+        out!("{}", finished.summary.table());
         for event in &finished.summary.events {
-            println!("event: {event}");
+            outln!("event: {event}");
         }
         if let Some(path) = &rrd {
-            println!(
+            outln!(
                 "recording: {} (open with `rerun {}`)",
                 path.display(),
                 path.display()
@@ -342,18 +348,51 @@ fn cmd_compare(args: &CompareArgs) -> Result<(), Failure> {
     if let Some(path) = &args.json {
         check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
     }
+    if let Some(dir) = &args.plots {
+        mergesim::plots::check_plot_dir(dir).map_err(|e| input(anyhow!(e)))?;
+    }
     let show_progress = std::io::stderr().is_terminal();
     let mut summaries = Vec::new();
+    let mut time_series = Vec::new();
     for &kind in &args.planners {
-        let finished = simulate(&scenario, Some(kind), args.seed, None, false, show_progress)?;
+        let finished = simulate(
+            &scenario,
+            Some(kind),
+            args.seed,
+            None,
+            args.plots.is_some(),
+            show_progress,
+        )?;
         summaries.push(finished.summary);
+        time_series.push(finished.outcome.time_series);
     }
-    print!("{}", comparison_table(&summaries));
+    out!("{}", comparison_table(&summaries));
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&summaries).map_err(run_failure)?;
         write_atomically(path, text.as_bytes())
             .with_context(|| format!("cannot write {}", path.display()))
             .map_err(run_failure)?;
+    }
+    if let Some(dir) = &args.plots {
+        let series: Vec<mergesim::plots::PlannerSeries<'_>> = summaries
+            .iter()
+            .zip(&time_series)
+            .map(|(s, rows)| mergesim::plots::PlannerSeries {
+                planner: &s.planner,
+                rows,
+            })
+            .collect();
+        let road = &scenario.instance(args.seed).sim.road;
+        let written = mergesim::plots::write_comparison(
+            dir,
+            road,
+            &series,
+            mergesim::plots::FigureSize::default(),
+        )
+        .map_err(run_failure)?;
+        for path in written {
+            outln!("wrote {}", path.display());
+        }
     }
     Ok(())
 }
@@ -451,7 +490,7 @@ fn cmd_maneuver(args: &ManeuverArgs) -> Result<(), Failure> {
             .with_context(|| format!("cannot write {}", path.display()))
             .map_err(run_failure)?;
     }
-    println!("{text}");
+    outln!("{text}");
     Ok(())
 }
 
@@ -460,7 +499,7 @@ fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
         ScenarioCommand::List => {
             for name in scenarios::builtin::names() {
                 let scenario = Scenario::load(name).map_err(run_failure)?;
-                println!("{name:<20} {}", scenario.description);
+                outln!("{name:<20} {}", scenario.description);
             }
         }
         ScenarioCommand::Show { name } => {
@@ -470,7 +509,7 @@ fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
                     scenarios::builtin::names().join(", ")
                 ))
             })?;
-            print!("{text}");
+            out!("{text}");
         }
     }
     Ok(())
@@ -584,7 +623,7 @@ fn cmd_sweep(args: &SweepArgs) -> Result<(), Failure> {
     let bar = if !args.quiet && std::io::stderr().is_terminal() {
         let bar = indicatif::ProgressBar::new(instances.end - instances.start);
         let style = indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:40}] {pos}/{len} runs, {per_sec}, ETA {eta}",
+            "{msg} [{bar:30}] {pos}/{len} runs, {per_sec}, ETA {eta}",
         )
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
         bar.set_style(style);
@@ -610,9 +649,9 @@ fn cmd_sweep(args: &SweepArgs) -> Result<(), Failure> {
         write_output(path, &text)?;
     }
     if !args.quiet {
-        print!("{}", outcome.summary.table());
+        out!("{}", outcome.summary.table());
         for row in outcome.summary.samples.iter().filter(|r| r.error.is_some()) {
-            println!(
+            outln!(
                 "run {} (seed {}) {:?}: {}",
                 row.instance,
                 row.seed,
@@ -646,7 +685,7 @@ fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> {
         write_output(path, &text)?;
     }
     if !args.quiet {
-        print!("{}", merged.table());
+        out!("{}", merged.table());
     }
     Ok(())
 }

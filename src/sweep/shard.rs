@@ -71,15 +71,22 @@ impl Shard {
 
     /// The shard a cluster scheduler assigned through the environment (see the module doc), or
     /// `None` when no scheduler variable is set. `var` looks a variable up (`std::env::var`).
-    pub fn from_environment(var: impl Fn(&str) -> Option<String>) -> Result<Option<Shard>, ShardError> {
+    pub fn from_environment(
+        var: impl Fn(&str) -> Option<String>,
+    ) -> Result<Option<Shard>, ShardError> {
         let number = |name: &str| -> Result<Option<u64>, ShardError> {
             match var(name) {
                 None => Ok(None),
-                Some(text) => text.trim().parse::<u64>().map(Some).map_err(|_| ShardError::Invalid {
-                    source_name: name.to_string(),
-                    value: text.clone(),
-                    reason: "not a non-negative integer".into(),
-                }),
+                Some(text) => {
+                    text.trim()
+                        .parse::<u64>()
+                        .map(Some)
+                        .map_err(|_| ShardError::Invalid {
+                            source_name: name.to_string(),
+                            value: text.clone(),
+                            reason: "not a non-negative integer".into(),
+                        })
+                }
             }
         };
         if let Some(id) = number("SLURM_ARRAY_TASK_ID")? {
@@ -101,13 +108,19 @@ impl Shard {
                     ),
                 });
             }
-            return Shard::new((id - min) / step, count, "SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT").map(Some);
+            return Shard::new(
+                (id - min) / step,
+                count,
+                "SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT",
+            )
+            .map(Some);
         }
         if let Some(index) = number("JOB_COMPLETION_INDEX")? {
             let count = number("MERGESIM_SHARD_COUNT")?.ok_or_else(|| ShardError::Invalid {
                 source_name: "MERGESIM_SHARD_COUNT".into(),
                 value: "<unset>".into(),
-                reason: "unset while JOB_COMPLETION_INDEX is set: set it to the Job's completions".into(),
+                reason: "unset while JOB_COMPLETION_INDEX is set: set it to the Job's completions"
+                    .into(),
             })?;
             return Shard::new(index, count, "JOB_COMPLETION_INDEX/MERGESIM_SHARD_COUNT").map(Some);
         }
@@ -134,7 +147,11 @@ impl FromStr for Shard {
         let (i, n) = text
             .split_once('/')
             .ok_or_else(|| invalid("expected i/n, e.g. 0/4 (0-based index / count)"))?;
-        let parse = |s: &str| s.trim().parse::<u64>().map_err(|_| invalid("expected i/n with non-negative integers"));
+        let parse = |s: &str| {
+            s.trim()
+                .parse::<u64>()
+                .map_err(|_| invalid("expected i/n with non-negative integers"))
+        };
         Shard::new(parse(i)?, parse(n)?, "--shard").map_err(|_| invalid("need 0 <= i < n"))
     }
 }
@@ -180,7 +197,10 @@ mod tests {
 
     #[test]
     fn parses_and_refuses_shard_text() {
-        assert_eq!("2/5".parse::<Shard>().unwrap(), Shard { index: 2, count: 5 });
+        assert_eq!(
+            "2/5".parse::<Shard>().unwrap(),
+            Shard { index: 2, count: 5 }
+        );
         assert_eq!("2/5".parse::<Shard>().unwrap().to_string(), "2/5");
         for bad in ["5/5", "1/0", "x/3", "3", "-1/4", "1/2/3", ""] {
             let err = bad.parse::<Shard>().unwrap_err().to_string();
@@ -191,31 +211,78 @@ mod tests {
     #[test]
     fn reads_slurm_and_kubernetes_variables() {
         let env = |pairs: &'static [(&'static str, &'static str)]| {
-            move |name: &str| pairs.iter().find(|(k, _)| *k == name).map(|(_, v)| v.to_string())
+            move |name: &str| {
+                pairs
+                    .iter()
+                    .find(|(k, _)| *k == name)
+                    .map(|(_, v)| v.to_string())
+            }
         };
         assert_eq!(Shard::from_environment(env(&[])).unwrap(), None);
-        let slurm = env(&[("SLURM_ARRAY_TASK_ID", "3"), ("SLURM_ARRAY_TASK_COUNT", "8")]);
-        assert_eq!(Shard::from_environment(slurm).unwrap(), Some(Shard { index: 3, count: 8 }));
+        let slurm = env(&[
+            ("SLURM_ARRAY_TASK_ID", "3"),
+            ("SLURM_ARRAY_TASK_COUNT", "8"),
+        ]);
+        assert_eq!(
+            Shard::from_environment(slurm).unwrap(),
+            Some(Shard { index: 3, count: 8 })
+        );
         let one_based = env(&[
             ("SLURM_ARRAY_TASK_ID", "8"),
             ("SLURM_ARRAY_TASK_COUNT", "8"),
             ("SLURM_ARRAY_TASK_MIN", "1"),
         ]);
-        assert_eq!(Shard::from_environment(one_based).unwrap(), Some(Shard { index: 7, count: 8 }));
+        assert_eq!(
+            Shard::from_environment(one_based).unwrap(),
+            Some(Shard { index: 7, count: 8 })
+        );
         let stepped = env(&[
             ("SLURM_ARRAY_TASK_ID", "6"),
             ("SLURM_ARRAY_TASK_COUNT", "4"),
             ("SLURM_ARRAY_TASK_MIN", "0"),
             ("SLURM_ARRAY_TASK_STEP", "2"),
         ]);
-        assert_eq!(Shard::from_environment(stepped).unwrap(), Some(Shard { index: 3, count: 4 }));
-        let k8s = env(&[("JOB_COMPLETION_INDEX", "0"), ("MERGESIM_SHARD_COUNT", "16")]);
-        assert_eq!(Shard::from_environment(k8s).unwrap(), Some(Shard { index: 0, count: 16 }));
+        assert_eq!(
+            Shard::from_environment(stepped).unwrap(),
+            Some(Shard { index: 3, count: 4 })
+        );
+        let k8s = env(&[
+            ("JOB_COMPLETION_INDEX", "0"),
+            ("MERGESIM_SHARD_COUNT", "16"),
+        ]);
+        assert_eq!(
+            Shard::from_environment(k8s).unwrap(),
+            Some(Shard {
+                index: 0,
+                count: 16
+            })
+        );
         let no_count = env(&[("JOB_COMPLETION_INDEX", "2")]);
-        assert!(Shard::from_environment(no_count).unwrap_err().to_string().contains("MERGESIM_SHARD_COUNT"));
-        let garbage = env(&[("SLURM_ARRAY_TASK_ID", "abc"), ("SLURM_ARRAY_TASK_COUNT", "4")]);
-        assert!(Shard::from_environment(garbage).unwrap_err().to_string().contains("abc"));
-        let outside = env(&[("SLURM_ARRAY_TASK_ID", "9"), ("SLURM_ARRAY_TASK_COUNT", "4")]);
-        assert!(Shard::from_environment(outside).unwrap_err().to_string().contains("9/4"));
+        assert!(
+            Shard::from_environment(no_count)
+                .unwrap_err()
+                .to_string()
+                .contains("MERGESIM_SHARD_COUNT")
+        );
+        let garbage = env(&[
+            ("SLURM_ARRAY_TASK_ID", "abc"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ]);
+        assert!(
+            Shard::from_environment(garbage)
+                .unwrap_err()
+                .to_string()
+                .contains("abc")
+        );
+        let outside = env(&[
+            ("SLURM_ARRAY_TASK_ID", "9"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ]);
+        assert!(
+            Shard::from_environment(outside)
+                .unwrap_err()
+                .to_string()
+                .contains("9/4")
+        );
     }
 }

@@ -26,8 +26,16 @@ pub fn wilson_interval(successes: u64, n: u64, z: f64) -> Option<[f64; 2]> {
     let centre = (p + z2 / (2.0 * n_f)) / denominator;
     let half = z / denominator * (p * (1.0 - p) / n_f + z2 / (4.0 * n_f * n_f)).sqrt();
     // The bounds at p̂ = 0 and p̂ = 1 are exactly 0 and 1; say so rather than round near them.
-    let lo = if successes == 0 { 0.0 } else { (centre - half).max(0.0) };
-    let hi = if successes == n { 1.0 } else { (centre + half).min(1.0) };
+    let lo = if successes == 0 {
+        0.0
+    } else {
+        (centre - half).max(0.0)
+    };
+    let hi = if successes == n {
+        1.0
+    } else {
+        (centre + half).min(1.0)
+    };
     Some([lo, hi])
 }
 
@@ -68,7 +76,10 @@ mod tests {
             (1, 29, 0.0061, 0.1718),
         ] {
             let [l, h] = wilson_interval(x, n, Z_95).unwrap();
-            assert!((l - lo).abs() < 6e-5 && (h - hi).abs() < 6e-5, "{x}/{n}: [{l}, {h}]");
+            assert!(
+                (l - lo).abs() < 6e-5 && (h - hi).abs() < 6e-5,
+                "{x}/{n}: [{l}, {h}]"
+            );
         }
     }
 
@@ -92,7 +103,14 @@ mod tests {
     fn nearest_rank_matches_the_textbook_example() {
         // The worked example of the nearest-rank method (five values 15, 20, 35, 40, 50).
         let v = [15.0, 20.0, 35.0, 40.0, 50.0];
-        for (p, expected) in [(5.0, 15.0), (30.0, 20.0), (40.0, 20.0), (50.0, 35.0), (100.0, 50.0), (0.0, 15.0)] {
+        for (p, expected) in [
+            (5.0, 15.0),
+            (30.0, 20.0),
+            (40.0, 20.0),
+            (50.0, 35.0),
+            (100.0, 50.0),
+            (0.0, 15.0),
+        ] {
             assert_eq!(nearest_rank_percentile(&v, p), Some(expected), "p{p}");
         }
         assert_eq!(nearest_rank_percentile(&[], 5.0), None);

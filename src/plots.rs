@@ -1,0 +1,581 @@
+//! Figures of a planner comparison (`merge_sim compare --plots DIR`): the paper's Fig. 3 (the
+//! paths of both vehicles, one panel per planner) and Fig. 4 (sideslip, yaw, yaw rate and speed
+//! over time, one line per planner) as PNG, plus the data behind them as one CSV.
+//!
+//! Rendering uses plotters' bitmap backend; text goes through `ab_glyph` with DejaVu Sans Mono
+//! embedded from `docs/fonts` (Bitstream Vera licence, `docs/fonts/LICENSE-DejaVu.txt`), so no
+//! system font library (fontconfig, freetype) is needed to build or run.
+//!
+//! Every file is written whole or not at all ([`crate::output::write_atomically`]).
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use planner::MergeRoad;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::{FontStyle, register_font};
+use sim::TimeSeriesRow;
+
+use crate::output::{temporary_path, write_atomically};
+
+/// The embedded font (DejaVu Sans Mono).
+const FONT_TTF: &[u8] = include_bytes!("../docs/fonts/DejaVuSansMono.ttf");
+
+/// Font family name the figures ask for; the embedded font is registered under it.
+const FONT_FAMILY: &str = "sans-serif";
+
+/// Figure of the paths (paper Fig. 3).
+pub const PATHS_PNG: &str = "paths.png";
+
+/// CSV with every plotted sample: `planner,` + [`TimeSeriesRow::CSV_HEADER`].
+pub const TIME_SERIES_CSV: &str = "time_series.csv";
+
+/// File name of the motion-state figure of one vehicle (paper Fig. 4 is the obstacle's).
+pub fn states_png(vehicle: &str) -> String {
+    format!("states_{vehicle}.png")
+}
+
+/// Size of every figure (pixels).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FigureSize {
+    /// Width (px).
+    pub width_px: u32,
+    /// Height of one panel (px); a figure is as high as its panels.
+    pub panel_height_px: u32,
+}
+
+impl Default for FigureSize {
+    fn default() -> Self {
+        Self {
+            width_px: 1400,
+            panel_height_px: 260,
+        }
+    }
+}
+
+/// The time series of one planner's run.
+#[derive(Clone, Copy, Debug)]
+pub struct PlannerSeries<'a> {
+    /// Planner name (`pf-cs`, ...).
+    pub planner: &'a str,
+    /// The run's time series (every vehicle, interleaved as the world logs them).
+    pub rows: &'a [TimeSeriesRow],
+}
+
+/// Why a figure could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// Writing or reading a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// plotters failed to draw.
+    #[error("drawing {figure}: {message}")]
+    Draw {
+        /// The figure's file name.
+        figure: String,
+        /// plotters' message.
+        message: String,
+    },
+    /// The embedded font could not be parsed.
+    #[error("the embedded font docs/fonts/DejaVuSansMono.ttf could not be loaded")]
+    Font,
+    /// There is nothing to draw.
+    #[error("nothing to plot: {0}")]
+    Empty(String),
+}
+
+/// Checks that `dir` is an existing, writable folder (before a long simulation).
+pub fn check_plot_dir(dir: &Path) -> Result<(), String> {
+    if dir.as_os_str().is_empty() {
+        return Err("--plots: empty path".into());
+    }
+    if !dir.is_dir() {
+        return Err(format!("--plots {}: not an existing folder", dir.display()));
+    }
+    let probe = dir.join(".mergesim_plots_probe.tmp");
+    std::fs::write(&probe, b"").map_err(|e| format!("--plots {}: {e}", dir.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+fn ensure_font() -> Result<(), PlotError> {
+    static REGISTERED: OnceLock<bool> = OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| {
+        [FontStyle::Normal, FontStyle::Bold]
+            .into_iter()
+            .all(|style| register_font(FONT_FAMILY, style, FONT_TTF).is_ok())
+    });
+    if ok { Ok(()) } else { Err(PlotError::Font) }
+}
+
+/// Line colour of a planner: the paper's (PF-CS red, PF-SP blue, PF-ISO green) and orange for
+/// the PF-ISO-PRED ablation; others cycle through plotters' palette.
+pub fn planner_color(planner: &str, index: usize) -> RGBColor {
+    match planner {
+        "pf-cs" => RGBColor(214, 39, 40),
+        "pf-sp" => RGBColor(31, 119, 180),
+        "pf-iso" => RGBColor(44, 160, 44),
+        "pf-iso-pred" => RGBColor(255, 127, 14),
+        _ => {
+            let c = Palette99::pick(index).to_rgba();
+            RGBColor(c.0, c.1, c.2)
+        }
+    }
+}
+
+/// Vehicle names in order of first appearance in the rows.
+pub fn vehicle_names(rows: &[TimeSeriesRow]) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    for row in rows {
+        if !names.contains(&row.vehicle) {
+            names.push(row.vehicle.clone());
+        }
+    }
+    names
+}
+
+/// The CSV of every run: `planner,` + the time-series columns, planners in the given order.
+pub fn comparison_csv(series: &[PlannerSeries<'_>]) -> String {
+    let mut text = format!("planner,{}\n", TimeSeriesRow::CSV_HEADER);
+    for s in series {
+        for row in s.rows {
+            text.push_str(s.planner);
+            text.push(',');
+            text.push_str(&row.csv_line());
+            text.push('\n');
+        }
+    }
+    text
+}
+
+/// Writes [`PATHS_PNG`], one [`states_png`] per vehicle and [`TIME_SERIES_CSV`] into `dir`;
+/// returns the written paths in that order.
+pub fn write_comparison(
+    dir: &Path,
+    road: &MergeRoad,
+    series: &[PlannerSeries<'_>],
+    size: FigureSize,
+) -> Result<Vec<PathBuf>, PlotError> {
+    if series.is_empty() || series.iter().all(|s| s.rows.is_empty()) {
+        return Err(PlotError::Empty(
+            "no time series (run with keep_time_series)".into(),
+        ));
+    }
+    ensure_font()?;
+    let mut written = Vec::new();
+    let mut vehicles: Vec<String> = Vec::new();
+    for s in series {
+        for name in vehicle_names(s.rows) {
+            if !vehicles.contains(&name) {
+                vehicles.push(name);
+            }
+        }
+    }
+
+    let path = dir.join(PATHS_PNG);
+    let height = size.panel_height_px * series.len() as u32;
+    render_png(&path, (size.width_px, height), |area| {
+        draw_paths(area, road, series, &vehicles)
+    })?;
+    written.push(path);
+
+    for vehicle in &vehicles {
+        let path = dir.join(states_png(vehicle));
+        render_png(&path, (size.width_px, 4 * size.panel_height_px), |area| {
+            draw_states(area, series, vehicle)
+        })?;
+        written.push(path);
+    }
+
+    let path = dir.join(TIME_SERIES_CSV);
+    write_atomically(&path, comparison_csv(series).as_bytes()).map_err(|source| PlotError::Io {
+        path: path.clone(),
+        source,
+    })?;
+    written.push(path);
+    Ok(written)
+}
+
+type DrawResult = Result<(), String>;
+
+/// Renders into a temporary PNG beside `path` (plotters encodes to a file), then moves the bytes
+/// into place with [`write_atomically`].
+fn render_png(
+    path: &Path,
+    size_px: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> DrawResult,
+) -> Result<(), PlotError> {
+    let figure = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    // plotters picks the encoder by extension: keep `.png` at the end.
+    let render_path = temporary_path(path).with_extension("render.png");
+    let result = (|| {
+        {
+            let backend = BitMapBackend::new(&render_path, size_px);
+            let area = backend.into_drawing_area();
+            area.fill(&WHITE).map_err(|e| e.to_string())?;
+            draw(&area)?;
+            area.present().map_err(|e| e.to_string())?;
+        }
+        Ok::<(), String>(())
+    })();
+    if let Err(message) = result {
+        let _ = std::fs::remove_file(&render_path);
+        return Err(PlotError::Draw { figure, message });
+    }
+    let bytes = std::fs::read(&render_path).map_err(|source| PlotError::Io {
+        path: render_path.clone(),
+        source,
+    });
+    let _ = std::fs::remove_file(&render_path);
+    write_atomically(path, &bytes?).map_err(|source| PlotError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn font(size: u32) -> TextStyle<'static> {
+    TextStyle::from((FONT_FAMILY, size).into_font()).color(&BLACK)
+}
+
+/// Range covering `values` with a relative margin; a degenerate range is widened to `min_span`.
+fn padded_range(values: impl Iterator<Item = f64>, margin: f64, min_span: f64) -> Range<f64> {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if !lo.is_finite() || !hi.is_finite() {
+        return 0.0..min_span;
+    }
+    let span = (hi - lo).max(min_span);
+    let mid = 0.5 * (lo + hi);
+    let half = 0.5 * span * (1.0 + 2.0 * margin);
+    (mid - half)..(mid + half)
+}
+
+/// Fig. 3: the road (edges, divider, merge section shaded) and each vehicle's path, one panel
+/// per planner; the first vehicle solid, the others dashed.
+fn draw_paths(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    road: &MergeRoad,
+    series: &[PlannerSeries<'_>],
+    vehicles: &[String],
+) -> DrawResult {
+    let x_range = padded_range(
+        series.iter().flat_map(|s| s.rows.iter().map(|r| r.x_m)),
+        0.01,
+        10.0,
+    );
+    let y_range = (road.y_bottom_m - 0.5)..(road.y_upper_m() + 0.5);
+    let panels = area.split_evenly((series.len(), 1));
+    for (panel, s) in panels.iter().zip(series) {
+        let mut chart = ChartBuilder::on(panel)
+            .caption(format!("{}: paths", s.planner), font(20))
+            .margin(8)
+            .x_label_area_size(34)
+            .y_label_area_size(56)
+            .build_cartesian_2d(x_range.clone(), y_range.clone())
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("x (m)")
+            .y_desc("y (m)")
+            .label_style(font(14))
+            .axis_desc_style(font(14))
+            .light_line_style(WHITE)
+            .draw()
+            .map_err(|e| e.to_string())?;
+        // Merge section, shaded as in the paper.
+        let merge = RGBColor(255, 200, 120).mix(0.35);
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [
+                    (road.merge_start_x_m, road.y_bottom_m),
+                    (road.merge_end_x_m, road.y_upper_m()),
+                ],
+                merge.filled(),
+            )))
+            .map_err(|e| e.to_string())?;
+        let edge = BLACK.stroke_width(2);
+        for line in [road.lower_edge_polyline(), road.upper_edge_polyline()] {
+            chart
+                .draw_series(LineSeries::new(
+                    line.into_iter().map(|p| (p[0], p[1])),
+                    edge,
+                ))
+                .map_err(|e| e.to_string())?;
+        }
+        let divider_end = road.merge_end_x_m.min(road.end_x_m);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [
+                    (road.start_x_m, road.y_lane_m()),
+                    (divider_end, road.y_lane_m()),
+                ],
+                8,
+                6,
+                RGBColor(120, 120, 120).stroke_width(1),
+            ))
+            .map_err(|e| e.to_string())?;
+        for (k, vehicle) in vehicles.iter().enumerate() {
+            let color = if k == 0 {
+                RGBColor(120, 60, 160)
+            } else {
+                let c = Palette99::pick(k + 2).to_rgba();
+                RGBColor(c.0, c.1, c.2)
+            };
+            let points: Vec<(f64, f64)> = s
+                .rows
+                .iter()
+                .filter(|r| r.vehicle == *vehicle)
+                .map(|r| (r.x_m, r.y_m))
+                .collect();
+            let style = color.stroke_width(2);
+            let anchor = if k == 0 {
+                chart
+                    .draw_series(LineSeries::new(points, style))
+                    .map_err(|e| e.to_string())?
+            } else {
+                chart
+                    .draw_series(DashedLineSeries::new(points, 10, 5, style))
+                    .map_err(|e| e.to_string())?
+            };
+            anchor
+                .label(vehicle.clone())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font(font(14))
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+/// Fig. 4: sideslip, yaw, yaw rate and speed of `vehicle` over time, one line per planner.
+fn draw_states(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    series: &[PlannerSeries<'_>],
+    vehicle: &str,
+) -> DrawResult {
+    type Getter = fn(&TimeSeriesRow) -> f64;
+    let quantities: [(&str, Getter, f64); 4] = [
+        ("sideslip β (rad)", |r| r.sideslip_rad, 0.002),
+        ("yaw ψ (rad)", |r| r.yaw_rad, 0.002),
+        ("yaw rate r (rad/s)", |r| r.yaw_rate_radps, 0.002),
+        ("speed v (m/s)", |r| r.speed_mps, 1.0),
+    ];
+    let t_range = padded_range(
+        series.iter().flat_map(|s| s.rows.iter().map(|r| r.t_s)),
+        0.0,
+        1.0,
+    );
+    let panels = area.split_evenly((quantities.len(), 1));
+    for (panel, (label, get, min_span)) in panels.iter().zip(quantities) {
+        let y_range = padded_range(
+            series
+                .iter()
+                .flat_map(|s| s.rows.iter().filter(|r| r.vehicle == vehicle).map(get)),
+            0.05,
+            min_span,
+        );
+        let mut chart = ChartBuilder::on(panel)
+            .caption(format!("{vehicle}: {label}"), font(18))
+            .margin(8)
+            .x_label_area_size(34)
+            .y_label_area_size(70)
+            .build_cartesian_2d(t_range.clone(), y_range)
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("t (s)")
+            .label_style(font(14))
+            .axis_desc_style(font(14))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        for (index, s) in series.iter().enumerate() {
+            let color = planner_color(s.planner, index);
+            let style = color.stroke_width(2);
+            let points: Vec<(f64, f64)> = s
+                .rows
+                .iter()
+                .filter(|r| r.vehicle == vehicle)
+                .map(|r| (r.t_s, get(r)))
+                .collect();
+            chart
+                .draw_series(LineSeries::new(points, style))
+                .map_err(|e| e.to_string())?
+                .label(s.planner.to_string())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerLeft)
+            .label_font(font(14))
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(t_s: f64, vehicle: &str, x_m: f64, y_m: f64) -> TimeSeriesRow {
+        TimeSeriesRow {
+            t_s,
+            vehicle: vehicle.into(),
+            x_m,
+            y_m,
+            yaw_rad: 0.01 * t_s,
+            yaw_rate_radps: 0.01,
+            sideslip_rad: 0.0,
+            speed_mps: 15.0,
+            planned_speed_mps: 15.0,
+            accel_long_mps2: 0.0,
+            accel_lat_mps2: 0.0,
+        }
+    }
+
+    #[test]
+    fn padded_range_contains_the_values_and_widens_a_constant() {
+        let r = padded_range([1.0, 3.0].into_iter(), 0.1, 0.5);
+        assert!(r.start < 1.0 && r.end > 3.0);
+        assert!((r.start - 0.8).abs() < 1e-12 && (r.end - 3.2).abs() < 1e-12);
+        let flat = padded_range([2.0, 2.0].into_iter(), 0.0, 0.5);
+        assert!((flat.end - flat.start - 0.5).abs() < 1e-12);
+        let empty = padded_range([f64::NAN].into_iter(), 0.0, 1.0);
+        assert_eq!(empty, 0.0..1.0);
+    }
+
+    #[test]
+    fn vehicle_names_keep_first_appearance_order() {
+        let rows = [
+            row(0.0, "ego", 0.0, 1.75),
+            row(0.0, "obstacle", 35.0, 5.25),
+            row(0.1, "ego", 2.0, 1.75),
+        ];
+        assert_eq!(vehicle_names(&rows), ["ego", "obstacle"]);
+    }
+
+    #[test]
+    fn csv_has_one_line_per_row_with_the_planner_first() {
+        let rows = [row(0.0, "ego", 0.0, 1.75), row(0.0, "obstacle", 35.0, 5.25)];
+        let text = comparison_csv(&[
+            PlannerSeries {
+                planner: "pf-cs",
+                rows: &rows,
+            },
+            PlannerSeries {
+                planner: "pf-iso",
+                rows: &rows[..1],
+            },
+        ]);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 4);
+        assert_eq!(lines[0], format!("planner,{}", TimeSeriesRow::CSV_HEADER));
+        assert!(lines[1].starts_with("pf-cs,0.0000,ego,"));
+        assert!(lines[3].starts_with("pf-iso,0.0000,ego,"));
+        let columns = lines[0].split(',').count();
+        assert!(lines.iter().all(|l| l.split(',').count() == columns));
+    }
+
+    #[test]
+    fn figures_are_png_files_and_no_temporary_file_is_left() {
+        let dir = std::env::temp_dir().join(format!("mergesim_plots_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let rows: Vec<TimeSeriesRow> = (0..50)
+            .flat_map(|i| {
+                let t = 0.1 * i as f64;
+                [
+                    row(t, "ego", 20.0 * t, 1.75),
+                    row(t, "obstacle", 35.0 + 15.0 * t, 5.25),
+                ]
+            })
+            .collect();
+        let series = [
+            PlannerSeries {
+                planner: "pf-cs",
+                rows: &rows,
+            },
+            PlannerSeries {
+                planner: "pf-iso",
+                rows: &rows,
+            },
+        ];
+        let size = FigureSize {
+            width_px: 400,
+            panel_height_px: 120,
+        };
+        let written = write_comparison(&dir, &MergeRoad::default(), &series, size).unwrap();
+        let names: Vec<String> = written
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(
+            names,
+            [
+                "paths.png",
+                "states_ego.png",
+                "states_obstacle.png",
+                "time_series.csv"
+            ]
+        );
+        for path in &written[..3] {
+            let bytes = std::fs::read(path).unwrap();
+            // PNG signature and the IHDR width/height (big endian) of the figure.
+            assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+            let width = u32::from_be_bytes(bytes[16..20].try_into().unwrap());
+            assert_eq!(width, 400);
+        }
+        let height = |name: &str| {
+            let bytes = std::fs::read(dir.join(name)).unwrap();
+            u32::from_be_bytes(bytes[20..24].try_into().unwrap())
+        };
+        assert_eq!(height("paths.png"), 2 * 120);
+        assert_eq!(height("states_obstacle.png"), 4 * 120);
+        let leftovers: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
+            .collect();
+        assert!(leftovers.is_empty(), "{leftovers:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn empty_series_is_an_error_not_a_panic() {
+        let err = write_comparison(
+            Path::new("."),
+            &MergeRoad::default(),
+            &[],
+            FigureSize::default(),
+        );
+        assert!(matches!(err, Err(PlotError::Empty(_))));
+    }
+
+    #[test]
+    fn a_missing_folder_is_rejected() {
+        assert!(check_plot_dir(Path::new("/definitely/not/here")).is_err());
+        assert!(check_plot_dir(Path::new("")).is_err());
+        assert!(check_plot_dir(&std::env::temp_dir()).is_ok());
+    }
+}

@@ -1,0 +1,94 @@
+//! Seeded Monte-Carlo statistics of the randomised urgent merge: the paper's per-planner claims,
+//! checked on average over randomised instances rather than on one hand-picked run (those that
+//! hold with the current planner tuning; see the note at the end of the test for one that does
+//! not).
+//!
+//! Both planners run the same instances (same sweep seed), so the comparisons are paired.
+
+use mergesim::planner::PlannerKind;
+use mergesim::scenarios::Scenario;
+use mergesim::sweep::{RunMetrics, Shard, SweepOptions, SweepPlan, SweepSummary, run_sweep};
+
+/// Runs per planner: enough for the averages below to be far from their noise (see the
+/// margins), few enough for the suite (≈ 0.2 s of CPU per run; 0 collisions in 64 runs bounds
+/// the collision rate below 5.7 % at 95 % confidence).
+const RUNS: u64 = 64;
+const SEED: u64 = 20_240_601;
+
+fn sweep(planner: PlannerKind) -> SweepSummary {
+    let plan = SweepPlan {
+        scenario: Scenario::load("urgent_merge").unwrap(),
+        planner: Some(planner),
+        runs: RUNS,
+        seed: SEED,
+        shard: Shard::WHOLE,
+    };
+    run_sweep(&plan, &SweepOptions::default(), &|| {})
+        .unwrap()
+        .summary
+}
+
+fn metrics(s: &SweepSummary) -> Vec<&RunMetrics> {
+    s.samples
+        .iter()
+        .map(|r| r.metrics.as_ref().unwrap())
+        .collect()
+}
+
+/// Mean and standard error of the paired differences a − b.
+fn paired(a: &[f64], b: &[f64]) -> (f64, f64) {
+    let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
+    let n = d.len() as f64;
+    let mean = d.iter().sum::<f64>() / n;
+    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+#[test]
+fn pf_iso_is_collision_free_and_resolves_the_merge_by_speed_unlike_pf_cs() {
+    let iso = sweep(PlannerKind::PfIso);
+    let cs = sweep(PlannerKind::PfCs);
+    for s in [&iso, &cs] {
+        assert_eq!(s.runs, RUNS);
+        assert_eq!(s.diverged, 0, "{}: {:?}", s.planner, s.samples);
+        // The instances really are randomised: the runs differ.
+        let gaps: Vec<f64> = metrics(s).iter().filter_map(|m| m.min_gap_m).collect();
+        let spread = gaps.iter().cloned().fold(f64::MIN, f64::max)
+            - gaps.iter().cloned().fold(f64::MAX, f64::min);
+        assert!(
+            spread > 0.05,
+            "{}: min gaps barely vary: {gaps:?}",
+            s.planner
+        );
+    }
+    // Safety: PF-ISO never collides, and has no more near misses than PF-CS.
+    assert_eq!(iso.collisions, 0, "PF-ISO collided: {:?}", iso.samples);
+    assert!(
+        iso.near_misses <= cs.near_misses,
+        "near misses: PF-ISO {} > PF-CS {}",
+        iso.near_misses,
+        cs.near_misses
+    );
+    let (mi, mc) = (metrics(&iso), metrics(&cs));
+    let diff = |get: fn(&RunMetrics) -> f64| {
+        let a: Vec<f64> = mi.iter().map(|m| get(m)).collect();
+        let b: Vec<f64> = mc.iter().map(|m| get(m)).collect();
+        paired(&a, &b)
+    };
+    // PF-ISO resolves the conflict by speed (the paper's early braking of the obstacle, 15 → 9.4
+    // m/s; DESIGN §5), PF-CS by definition cannot: the lowest speed of any vehicle is lower with PF-ISO, by more than three standard
+    // errors of the paired difference.
+    let (d, se) = diff(|m| m.min_speed_mps);
+    eprintln!("min speed: PF-ISO − PF-CS = {d:.4} ± {se:.4} m/s");
+    assert!(
+        d < -3.0 * se,
+        "min speed: PF-ISO − PF-CS = {d:.3} ± {se:.3} m/s"
+    );
+    // Not asserted: the paper (Sec. V, Figs. 7–9) has PF-CS with the largest sideslip, yaw and
+    // yaw-rate peaks. With the planner tuning of this commit that ordering does not hold on
+    // average over randomised instances. Measured on these 64 instances (paired PF-ISO − PF-CS,
+    // mean ± standard error): peak |r| +0.0039 ± 0.0015 rad/s, peak |β| −0.0001 ± 0.0001 rad,
+    // peak |ψ| +0.0006 ± 0.0001 rad: all peaks are small (|r| ≈ 0.04 rad/s) and PF-ISO's are
+    // not smaller. Reported rather than tested, so that the suite does not certify a claim the
+    // code does not reproduce.
+}
