@@ -525,6 +525,21 @@ impl World {
                     plan.cubic, plan.cubic_x_scale_m, ys.join(" "), ws.join(" ")
                 );
             }
+            if std::env::var_os("MSDBG2").is_some() && agent.spec.name == "obstacle" && ((t_s * 10.0).round() as i64 == 120 || (t_s * 10.0).round() as i64 == 121) {
+                let field = planner.field(&request);
+                let mut p = [request.ego.x_m, request.ego.y_m];
+                for k in 0..80 {
+                    let f = field.stepping_force(p[0], p[1]);
+                    let psi = f[1].atan2(f[0]);
+                    eprintln!("SUB {t_s:.1} {k} {:.3} {:.4} F {:.4} {:.4} psi {:.4}", p[0], p[1], f[0], f[1], psi);
+                    p = [p[0] + psi.cos(), p[1] + psi.sin()];
+                }
+                for sub in [1.0, 0.25, 0.05] {
+                    let w = planner::local_path::local_path(&field, [request.ego.x_m, request.ego.y_m], 6.0, 20, sub, 0.0);
+                    let ys: Vec<String> = w.iter().map(|p| format!("{:.1},{:.3}", p[0], p[1])).collect();
+                    eprintln!("WP {t_s:.1} sub {sub} {}", ys.join(" "));
+                }
+            }
             agent.path = plan.path.clone();
             if agent.spec.connected {
                 broadcasts.push(plan.shared.clone());
