@@ -81,6 +81,11 @@ pub struct PlannerParams {
     /// Eq. 7 is one sub-step per waypoint; shorter sub-steps follow the force's stream line
     /// instead of zig-zagging over the divider ridge when L_s is several metres.
     pub max_substep_m: f64,
+    /// Largest turn of ψ_ref across one sub-step (rad): a longer sub-step is halved (down to
+    /// 1/64 of the fixed one) so the integration follows the stream line where the field is
+    /// stiff across the path (the road edge's wall) instead of bouncing off it, which made the
+    /// far waypoints jump from plan to plan (`local_path` module doc). 0 keeps fixed sub-steps.
+    pub substep_max_turn_rad: f64,
 
     // ---------------------------------------------------------------- Eqs. 8–9 (cubic fit)
     /// Weight of the vehicle's own position as a data point of the fit (waypoints weigh 1).
@@ -189,6 +194,9 @@ impl Default for PlannerParams {
             step_time_s: 0.4,
             min_step_m: 1.0,
             max_substep_m: 1.0,
+            // A smooth stream line turns by κ·h ≤ 0.05 rad per 1 m sub-step at the cubic's
+            // curvature bound, so only sub-steps turning twice that are refined.
+            substep_max_turn_rad: 0.1,
             predict_obstacles_in_path: false,
             cubic_origin_weight: 10.0,
             cubic_max_offset_m: 0.5,
@@ -279,6 +287,7 @@ impl PlannerParams {
             ("interaction_weight", self.interaction_weight),
             ("scp_relative_tolerance", self.scp_relative_tolerance),
             ("max_shared_path_age_s", self.max_shared_path_age_s),
+            ("substep_max_turn_rad", self.substep_max_turn_rad),
         ];
         for (name, value) in non_negative {
             if !(value.is_finite() && value >= 0.0) {

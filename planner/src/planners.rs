@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use crate::cubic_fit::{FitMethod, fit_path_cubic};
 use crate::error::PlannerError;
 use crate::fallback::{FallbackInput, fallback_plan};
-use crate::local_path::local_path;
+use crate::local_path::local_path_adaptive;
 use crate::obstacle_field::{ObstacleField, SelfView};
 use crate::params::PlannerParams;
 use crate::polyline::Polyline;
@@ -410,12 +410,13 @@ impl PfPlanner {
         } else {
             0.0
         };
-        let waypoints = local_path(
+        let waypoints = local_path_adaptive(
             &field,
             [req.ego.x_m, req.ego.y_m],
             step_m,
             n,
             params.max_substep_m,
+            params.substep_max_turn_rad,
             time_per_step_s,
         );
         if waypoints.iter().flatten().any(|v| !v.is_finite()) {

@@ -297,15 +297,6 @@ impl World {
                 agent.path = lane_keeping_path(&self.config, &agent.spec, &kin, t_s);
             }
             let controls = agent.tracker.update(&kin, &agent.path, dt_s);
-            if std::env::var_os("MSDBG").is_some() {
-                let d = agent.tracker.debug();
-                eprintln!(
-                    "STEP {t_s:.3} {} y {:.5} yaw {:.6} r {:.5} beta {:.6} steer {:.6} cmd {:.6} la {:.3} {:.4} cte {:.5}",
-                    agent.spec.name, kin.y_m, kin.yaw_rad, kin.yaw_rate_radps, kin.sideslip_rad,
-                    kin.steer_rad, controls.steer_rad, d.lookahead_point_m[0], d.lookahead_point_m[1],
-                    d.cross_track_error_m
-                );
-            }
             agent.vehicle.set_controls(controls);
             agent
                 .vehicle
@@ -515,30 +506,6 @@ impl World {
             }
             if self.step_index.is_multiple_of(self.steps_per_field) && self.recorder.is_enabled() {
                 log_field(&mut self.recorder, planner, &request, &agent.spec.name)?;
-            }
-            if std::env::var_os("MSDBG").is_some() {
-                let ys: Vec<String> = plan.path.iter().take(6).map(|p| format!("{:.2},{:.4}", p.x_m, p.y_m)).collect();
-                let ws: Vec<String> = plan.waypoints.iter().take(20).map(|p| format!("{:.2},{:.4}", p[0], p[1])).collect();
-                eprintln!(
-                    "PLAN {t_s:.3} {} ego {:.3},{:.5},{:.6} cubic {:?} S {:.2} path {} wp {}",
-                    agent.spec.name, request.ego.x_m, request.ego.y_m, request.ego.yaw_rad,
-                    plan.cubic, plan.cubic_x_scale_m, ys.join(" "), ws.join(" ")
-                );
-            }
-            if std::env::var_os("MSDBG2").is_some() && agent.spec.name == "obstacle" && ((t_s * 10.0).round() as i64 == 120 || (t_s * 10.0).round() as i64 == 121) {
-                let field = planner.field(&request);
-                let mut p = [request.ego.x_m, request.ego.y_m];
-                for k in 0..80 {
-                    let f = field.stepping_force(p[0], p[1]);
-                    let psi = f[1].atan2(f[0]);
-                    eprintln!("SUB {t_s:.1} {k} {:.3} {:.4} F {:.4} {:.4} psi {:.4}", p[0], p[1], f[0], f[1], psi);
-                    p = [p[0] + psi.cos(), p[1] + psi.sin()];
-                }
-                for sub in [1.0, 0.25, 0.05] {
-                    let w = planner::local_path::local_path(&field, [request.ego.x_m, request.ego.y_m], 6.0, 20, sub, 0.0);
-                    let ys: Vec<String> = w.iter().map(|p| format!("{:.1},{:.3}", p[0], p[1])).collect();
-                    eprintln!("WP {t_s:.1} sub {sub} {}", ys.join(" "));
-                }
             }
             agent.path = plan.path.clone();
             if agent.spec.connected {
