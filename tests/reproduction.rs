@@ -112,13 +112,6 @@ fn path_length_m(outcome: &RunOutcome, vehicle: &str) -> f64 {
         .sum()
 }
 
-fn rms_yaw_rate_radps(outcome: &RunOutcome, vehicle: &str) -> f64 {
-    let (sum, n) = rows(outcome, vehicle).fold((0.0, 0usize), |(s, n), r| {
-        (s + r.yaw_rate_radps * r.yaw_rate_radps, n + 1)
-    });
-    (sum / n.max(1) as f64).sqrt()
-}
-
 fn collisions(outcome: &RunOutcome) -> usize {
     outcome.safety.collisions.len() + outcome.safety.edge_contacts.len()
 }
@@ -208,15 +201,13 @@ fn check_findings(p: Perturbation) {
         // the paper's late braking of PF-SP is not reproduced).
         assert!(min_speed_mps(outcome, OBSTACLE) > obstacle_target_mps - SLOWING_THRESHOLD_MPS);
     }
-    // The obstacle's yaw-rate oscillation (RMS over the run) is smaller with PF-ISO than with
-    // PF-CS. (The peak values, the paper's measure, are not ordered robustly: they are set by
-    // single tracking spikes of a few hundredths of a rad/s.)
-    let iso_rms = rms_yaw_rate_radps(&iso, OBSTACLE);
-    let cs_rms = rms_yaw_rate_radps(&cs, OBSTACLE);
-    assert!(
-        iso_rms < cs_rms,
-        "{p:?}: obstacle RMS yaw rate PF-ISO {iso_rms:.5} vs PF-CS {cs_rms:.5}"
-    );
+    // Not asserted: the obstacle's yaw-rate oscillation ordered by planner (PF-ISO below PF-CS),
+    // neither as peak (the paper's measure) nor as RMS. The RMS ordering that used to hold was a
+    // numerical artifact: the fixed 1 m sub-steps of the path integration (Eq. 7) bounced off
+    // the road-edge field and made the obstacle's path chatter, most with PF-CS; with adaptive
+    // sub-steps every planner's obstacle peaks at ≈ 0.032 rad/s and PF-ISO's RMS is not lower
+    // (nominal 8.8 vs 8.4 mrad/s).
+    // See docs/reproduction.md.
 }
 
 #[test]
