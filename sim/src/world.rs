@@ -58,6 +58,23 @@ pub struct TimeSeriesRow {
 }
 
 impl TimeSeriesRow {
+    /// The row of vehicle `name` for one metrics sample and the speed its plan asked for.
+    pub fn from_sample(name: &str, sample: &MetricsSample, planned_speed_mps: f64) -> Self {
+        Self {
+            t_s: sample.t_s,
+            vehicle: name.to_string(),
+            x_m: sample.x_m,
+            y_m: sample.y_m,
+            yaw_rad: sample.yaw_rad,
+            yaw_rate_radps: sample.yaw_rate_radps,
+            sideslip_rad: sample.sideslip_rad,
+            speed_mps: sample.speed_mps,
+            planned_speed_mps,
+            accel_long_mps2: sample.accel_long_mps2,
+            accel_lat_mps2: sample.accel_lat_mps2,
+        }
+    }
+
     /// CSV header, in the order of [`TimeSeriesRow::csv_line`].
     pub const CSV_HEADER: &'static str = "t_s,vehicle,x_m,y_m,yaw_rad,yaw_rate_radps,sideslip_rad,speed_mps,planned_speed_mps,accel_long_mps2,accel_lat_mps2";
 
@@ -546,19 +563,20 @@ impl World {
                 self.events.push(text);
             }
             let planned_speed_mps = planned_speed_at(&agent.path, t_s).unwrap_or(k.speed_mps);
+            let sample = MetricsSample {
+                t_s,
+                x_m: k.x_m,
+                y_m: k.y_m,
+                yaw_rad: k.yaw_rad,
+                yaw_rate_radps: k.yaw_rate_radps,
+                sideslip_rad: k.sideslip_rad,
+                speed_mps: k.speed_mps,
+                accel_long_mps2: k.accel_long_mps2,
+                accel_lat_mps2: k.accel_lat_mps2,
+            };
             agent
                 .metrics
-                .push(&MetricsSample {
-                    t_s,
-                    x_m: k.x_m,
-                    y_m: k.y_m,
-                    yaw_rad: k.yaw_rad,
-                    yaw_rate_radps: k.yaw_rate_radps,
-                    sideslip_rad: k.sideslip_rad,
-                    speed_mps: k.speed_mps,
-                    accel_long_mps2: k.accel_long_mps2,
-                    accel_lat_mps2: k.accel_lat_mps2,
-                })
+                .push(&sample)
                 .map_err(|e| SimError::Diverged {
                     t_s,
                     what: format!("metrics of {}: {e}", agent.spec.name),
@@ -588,19 +606,11 @@ impl World {
                 }
             }
             if self.keep_time_series {
-                self.time_series.push(TimeSeriesRow {
-                    t_s,
-                    vehicle: agent.spec.name.clone(),
-                    x_m: k.x_m,
-                    y_m: k.y_m,
-                    yaw_rad: k.yaw_rad,
-                    yaw_rate_radps: k.yaw_rate_radps,
-                    sideslip_rad: k.sideslip_rad,
-                    speed_mps: k.speed_mps,
+                self.time_series.push(TimeSeriesRow::from_sample(
+                    &agent.spec.name,
+                    &sample,
                     planned_speed_mps,
-                    accel_long_mps2: k.accel_long_mps2,
-                    accel_lat_mps2: k.accel_lat_mps2,
-                });
+                ));
             }
         }
         Ok(())
