@@ -415,7 +415,8 @@ impl Recorder {
                 [[
                     (road.merge_start_x_m + half_length) as f32,
                     (road.y_bottom_m + half_width) as f32,
-                    0.0,
+                    // Under the potential-field grids, so it does not tint them.
+                    (self.params.field_z_m - 0.1) as f32,
                 ]],
                 [[half_length as f32, half_width as f32, 0.005]],
             )
@@ -605,7 +606,13 @@ impl Recorder {
                 reason: "grid too large".into(),
             });
         };
-        let z = self.params.field_z_m as f32;
+        // One height per vehicle (in name order), so overlapping fields do not z-fight.
+        let layer = active
+            .name_colors
+            .keys()
+            .position(|n| n == name)
+            .unwrap_or(active.name_colors.len());
+        let z = (self.params.field_z_m - 0.01 * layer as f64) as f32;
         let positions = (0..height).flat_map(|j| {
             (0..width).map(move |i| {
                 [
