@@ -96,10 +96,27 @@ pub fn check_plot_dir(dir: &Path) -> Result<(), String> {
     if dir.as_os_str().is_empty() {
         return Err("--plots: empty path".into());
     }
-    if !dir.is_dir() {
-        return Err(format!("--plots {}: not an existing folder", dir.display()));
+    if dir.exists() && !dir.is_dir() {
+        return Err(format!("--plots {}: exists and is not a folder", dir.display()));
     }
-    let probe = dir.join(".mergesim_plots_probe.tmp");
+    // A missing folder is created after the runs (one level, like `mkdir`): its parent must
+    // exist and be writable.
+    let probe_dir = if dir.is_dir() {
+        dir
+    } else {
+        match dir.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        }
+    };
+    if !probe_dir.is_dir() {
+        return Err(format!(
+            "--plots {}: folder {} does not exist",
+            dir.display(),
+            probe_dir.display()
+        ));
+    }
+    let probe = probe_dir.join(".mergesim_plots_probe.tmp");
     std::fs::write(&probe, b"").map_err(|e| format!("--plots {}: {e}", dir.display()))?;
     let _ = std::fs::remove_file(&probe);
     Ok(())
@@ -169,6 +186,12 @@ pub fn write_comparison(
         ));
     }
     ensure_font()?;
+    if !dir.is_dir() {
+        std::fs::create_dir(dir).map_err(|e| PlotError::Io {
+            path: dir.to_path_buf(),
+            source: e,
+        })?;
+    }
     let mut written = Vec::new();
     let mut vehicles: Vec<String> = Vec::new();
     for s in series {
@@ -575,6 +598,8 @@ mod tests {
     #[test]
     fn a_missing_folder_is_rejected() {
         assert!(check_plot_dir(Path::new("/definitely/not/here")).is_err());
+        // A missing folder whose parent exists is created later.
+        assert!(check_plot_dir(&std::env::temp_dir().join("mergesim_new_plots")).is_ok());
         assert!(check_plot_dir(Path::new("")).is_err());
         assert!(check_plot_dir(&std::env::temp_dir()).is_ok());
     }
