@@ -97,7 +97,10 @@ pub fn check_plot_dir(dir: &Path) -> Result<(), String> {
         return Err("--plots: empty path".into());
     }
     if dir.exists() && !dir.is_dir() {
-        return Err(format!("--plots {}: exists and is not a folder", dir.display()));
+        return Err(format!(
+            "--plots {}: exists and is not a folder",
+            dir.display()
+        ));
     }
     // A missing folder is created after the runs (one level, like `mkdir`): its parent must
     // exist and be writable.
