@@ -5,8 +5,8 @@ import sys
 import rerun.blueprint as rrb
 
 series = ["sideslip_rad", "yaw_rad", "yaw_rate_radps", "speed_mps", "planned_speed_mps"]
-eye = rrb.EyeControls3D(kind=rrb.Eye3DKind.Orbital, position=[172.0, -20.0, 16.0],
-                        look_target=[212.0, 3.5, 0.0], eye_up=[0.0, 0.0, 1.0])
+eye = rrb.EyeControls3D(kind=rrb.Eye3DKind.Orbital, position=[176.0, -17.0, 13.0],
+                        look_target=[214.0, 3.5, 0.0], eye_up=[0.0, 0.0, 1.0])
 road = rrb.Spatial3DView(name="Road", origin="/world", eye_controls=eye,
                          contents=["$origin/**", "- /world/fields/obstacle"], background=[30, 30, 34])
 left = rrb.Vertical(road, rrb.TextLogView(name="Events", origin="/events"), row_shares=[3, 1])
