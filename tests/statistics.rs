@@ -88,8 +88,8 @@ fn pf_iso_is_collision_free_and_resolves_the_merge_by_speed_unlike_pf_cs() {
     // yaw-rate peaks. That ordering does not hold on average over randomised instances. Measured
     // on these 64 instances with the planner of this commit (paired PF-ISO − PF-CS, mean ±
     // standard error; `merge_sim sweep --scenario urgent_merge --runs 64 --seed 20240601` per
-    // planner): peak |r| +0.0022 ± 0.0007 rad/s, peak |β| +0.00016 ± 0.00003 rad, peak |ψ|
-    // +0.00006 ± 0.00014 rad, yaw-rate sign changes +1.4 ± 0.2: all peaks are small (|r| ≈
+    // planner): peak |r| +0.0019 ± 0.0007 rad/s, peak |β| +0.00015 ± 0.00003 rad, peak |ψ|
+    // +0.00003 ± 0.00015 rad, yaw-rate sign changes +1.4 ± 0.2: all peaks are small (|r| ≈
     // 0.03 rad/s) and PF-ISO's are not smaller (docs/reproduction.md explains why). Reported
     // rather than tested, so that the suite does not certify a claim the code does not
     // reproduce.
