@@ -334,8 +334,8 @@ impl World {
             for (agent, kin) in self.agents.iter().zip(&kins) {
                 check_finite(t_s, &agent.spec.name, kin)?;
             }
+            let bodies = self.body_states(&kins);
             if need_safety {
-                let bodies = self.body_states(&kins);
                 self.safety
                     .check(t_s, &bodies, self.config.safety_period_s)
                     .map_err(|e| SimError::Diverged {
@@ -346,7 +346,7 @@ impl World {
             }
             // 6. Metrics, time series, recording.
             if need_log {
-                self.log_instant(t_s, &kins)?;
+                self.log_instant(t_s, &kins, &bodies)?;
             }
         }
         Ok(())
@@ -542,12 +542,16 @@ impl World {
         Ok(())
     }
 
-    fn log_instant(&mut self, t_s: f64, kins: &[Kinematics]) -> Result<(), SimError> {
-        let bodies = self.body_states(kins);
-        let names = self.names();
+    fn log_instant(
+        &mut self,
+        t_s: f64,
+        kins: &[Kinematics],
+        bodies: &[BodyState],
+    ) -> Result<(), SimError> {
         if self.recorder.is_enabled() {
+            let names = self.names();
             self.recorder.set_time(t_s).map_err(rec)?;
-            self.recorder.log_vehicles(&bodies, &names).map_err(rec)?;
+            self.recorder.log_vehicles(bodies, &names).map_err(rec)?;
         }
         let y_lane_m = self.config.road.y_lane_m();
         for (agent, k) in self.agents.iter_mut().zip(kins) {
