@@ -73,9 +73,12 @@ pub struct PlannerParams {
     pub min_step_m: f64,
     /// Evaluate each obstacle's field at its constant-velocity position at the time the ego
     /// reaches the waypoint being stepped (k·Δt_plan) instead of at its current position.
-    /// The paper steps against the current positions (off by default for fidelity); with it on,
-    /// a faster ego no longer plans to slip into the gap the slower car occupies now but will
-    /// have left when the ego arrives.
+    /// The paper steps against the current positions (`false`). On by default: a path stepped
+    /// against where the others are *now* meets a leader's field head-on ≈ 70 m ahead and
+    /// passes it on one side or the other, flipping from cycle to cycle, which makes the
+    /// follower's yaw rate spike; it also lets a faster ego plan into the gap a slower car
+    /// occupies now but will have left when the ego arrives (docs/reproduction.md,
+    /// "Calibration").
     pub predict_obstacles_in_path: bool,
     /// Longest sub-step of the gradient integration inside one waypoint step (m). The paper's
     /// Eq. 7 is one sub-step per waypoint; shorter sub-steps follow the force's stream line
@@ -177,14 +180,14 @@ impl Default for PlannerParams {
             obstacle_epsilon: 3e-4,
             obstacle_lateral_safety_m: 3.5,
             obstacle_fraction_at_min_distance: 0.1,
-            // Between the 2- and 3-second following rules of driver manuals: the follower's
-            // D_min is (l + l_o)/2 + 2.5 s · v_f (+ the braking term), 42 m at 15 m/s. It sets
-            // how much room the obstacle opens for the merging ego in PF-ISO. 3 s opens more
-            // (the obstacle slows to ≈ 13.3 instead of ≈ 13.9 m/s) but, with the 8 s horizon,
-            // makes a leader without `interaction_rear_only` slow down to let a constant-
-            // velocity follower "pass through" it instead of speeding up (planner test
-            // `a_follower_does_not_push_the_leader_...`); see docs/reproduction.md.
-            obstacle_time_gap_s: 2.5,
+            // The 3-second following rule of driver manuals: the follower's D_min is
+            // (l + l_o)/2 + 3 s · v_f (+ the braking term), 49.5 m at 15 m/s. It sets how much
+            // room the obstacle opens for the merging ego in PF-ISO (it slows to ≈ 13.4 m/s;
+            // with 2.5 s ≈ 13.9 m/s, too little for the paper's ordering of the obstacle's yaw
+            // rate to survive the perturbations; with 3.5 s the six-car `dense_merge` spreads
+            // out so much that its last car is still in the merge section after 30 s).
+            // docs/reproduction.md, "Calibration".
+            obstacle_time_gap_s: 3.0,
             ego_mass_factor: 1.0,
             other_mass_factor: 1.0,
             waypoint_count: 20,
@@ -197,7 +200,8 @@ impl Default for PlannerParams {
             // A smooth stream line turns by κ·h ≤ 0.05 rad per 1 m sub-step at the cubic's
             // curvature bound, so only sub-steps turning twice that are refined.
             substep_max_turn_rad: 0.1,
-            predict_obstacles_in_path: false,
+            // Obstacles where they will be, not where they are (see the field doc).
+            predict_obstacles_in_path: true,
             cubic_origin_weight: 10.0,
             cubic_max_offset_m: 0.5,
             cubic_max_heading_rad: 0.35,
