@@ -74,7 +74,7 @@ pub struct PlannerParams {
     /// Evaluate each obstacle's field at its constant-velocity position at the time the ego
     /// reaches the waypoint being stepped (k·Δt_plan) instead of at its current position.
     /// The paper steps against the current positions (`false`). On by default: a path stepped
-    /// against where the others are *now* meets a leader's field head-on ≈ 70 m ahead and
+    /// against where the others are *now* meets a leader's field head-on ≈ 80 m ahead and
     /// passes it on one side or the other, flipping from cycle to cycle, which makes the
     /// follower's yaw rate spike; it also lets a faster ego plan into the gap a slower car
     /// occupies now but will have left when the ego arrives (docs/reproduction.md,
@@ -211,9 +211,10 @@ impl Default for PlannerParams {
             min_speed_mps: 0.5,
             travel_time_weight: 1.0,
             speed_deviation_weight: 1.0,
-            // w3 / w2 = 15 with the floor below: the obstacle gives up ≈ 2 m/s to open the
-            // gap; from w3 ≈ 25 (or a floor of 0.01) the non-convex term starts to tip the
-            // perturbed merges into the ego yielding instead (docs/reproduction.md).
+            // w3 / w2 = 15 with the floor below: the obstacle gives up ≈ 1.6 m/s to open the
+            // gap. More buys little depth (w3 = 25: 13.3 instead of 13.4 m/s) and from w3 ≈ 40
+            // the non-convex term tips a perturbed merge (obstacle at 16 m/s) into the ego
+            // yielding instead (docs/reproduction.md).
             interaction_weight: 15.0,
             // The term acts out to U ≈ 0.02, about 1.3 D_min (exp(−q) = 0.02 ⇔ q = 3.9 against
             // q = 2.3 at D_min for the default fraction 0.1): a little beyond the safety
