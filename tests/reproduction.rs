@@ -326,3 +326,29 @@ fn in_the_worst_corner_only_the_interactive_planner_avoids_the_collision() {
         assert!(ego_last.x_m < obstacle_last.x_m);
     }
 }
+
+/// Where the two outcomes meet (obstacle start 45–53 m: up to 46 m the obstacle makes room,
+/// from 47 m the ego yields): with the shared paths PF-ISO switches between them without a
+/// collision; with constant-velocity predictions instead (PF-ISO-PRED, no V2V) the two vehicles
+/// misread each other's intent and race into each other at some starts (47.2–50.8 m measured;
+/// docs/reproduction.md, "Where the two equilibria meet").
+#[test]
+fn at_the_switch_between_the_equilibria_only_shared_paths_avoid_the_collision() {
+    let mut pred_collisions = 0;
+    for start_m in 45..=53 {
+        let mut scenario = variant(Perturbation::Nominal);
+        vehicle_mut(&mut scenario, OBSTACLE).x_m = f64::from(start_m);
+        let (iso, pred) = std::thread::scope(|s| {
+            let pred = s.spawn(|| run(&scenario, PlannerKind::PfIsoPred));
+            (run(&scenario, PlannerKind::PfIso), pred.join().unwrap())
+        });
+        assert_eq!(
+            collisions(&iso),
+            0,
+            "PF-ISO, obstacle start {start_m} m: {:?}",
+            iso.events
+        );
+        pred_collisions += usize::from(collisions(&pred) > 0);
+    }
+    assert!(pred_collisions > 0, "PF-ISO-PRED never collided");
+}
