@@ -4,45 +4,22 @@
 //! `tests/planners.rs`: ego at x = 0 m in the ending lane at 20 m/s, obstacle in the through
 //! lane at 15 m/s, both with the default planner parameters, replanning every 0.1 s for 20 s,
 //! ideal V2V (each receives the other's latest shared local path), and each vehicle moved along
-//! its own timed plan (no tracker, no tyres). For every obstacle start and planner kind it
-//! prints when and where (ego x) the two bodies (oriented rectangles) first overlap, if ever,
-//! where the ego's centre crosses the divider and how far ahead (+) or behind (−) of the
-//! obstacle's centre, the ego's minimum and maximum speeds, the obstacle's minimum speed, and
-//! the number of fallback plans.
+//! its own timed plan (`Plan::kinematic_state_at`: no tracker, no tyres). For every obstacle
+//! start and planner kind it prints when and where (ego x) the two bodies (oriented rectangles)
+//! first overlap, if ever, where the ego's centre crosses the divider and how far ahead (+) or
+//! behind (−) of the obstacle's centre, the ego's minimum and maximum speeds, the obstacle's
+//! minimum speed, and the number of fallback plans.
 //!
 //! `cargo run --release -p planner --example rollout_sweep`
 
 use planner::{
-    Lane, MergeRoad, Neighbour, PfPlanner, Plan, PlanRequest, PlannerKind, PlannerParams,
+    Lane, MergeRoad, Neighbour, PfPlanner, PlanRequest, PlannerKind, PlannerParams,
     SharedLocalPath, VehicleShape, VehicleState,
 };
 
 /// Replanning period and roll-out length (s).
 const STEP_S: f64 = 0.1;
 const STEPS: usize = 200;
-
-/// Moves a vehicle along its plan to `t_s`: position and heading from the timed path, speed
-/// ramping from the current speed to the first planned speed over the first segment (as in
-/// `tests/planners.rs`).
-fn advance(plan: &Plan, now: &VehicleState, t_s: f64) -> VehicleState {
-    let path = &plan.path;
-    let k = path
-        .partition_point(|p| p.t_s <= t_s)
-        .clamp(1, path.len() - 1);
-    let (a, b) = (path[k - 1], path[k]);
-    let f = ((t_s - a.t_s) / (b.t_s - a.t_s)).clamp(0.0, 1.0);
-    let speed_mps = if k == 1 {
-        now.speed_mps + f * (a.speed_mps - now.speed_mps)
-    } else {
-        a.speed_mps
-    };
-    VehicleState {
-        x_m: a.x_m + f * (b.x_m - a.x_m),
-        y_m: a.y_m + f * (b.y_m - a.y_m),
-        yaw_rad: (b.y_m - a.y_m).atan2(b.x_m - a.x_m),
-        speed_mps,
-    }
-}
 
 /// Corners of a vehicle's body rectangle (world frame).
 fn corners(s: &VehicleState, shape: &VehicleShape) -> [[f64; 2]; 4] {
@@ -136,7 +113,7 @@ fn roll_out(kind: PlannerKind, obstacle_x_m: f64) -> Result<Outcome, Box<dyn std
         }
         shared = plans.iter().map(|p| p.shared.clone()).collect();
         for (state, plan) in states.iter_mut().zip(&plans) {
-            *state = advance(plan, state, t_s + STEP_S);
+            *state = plan.kinematic_state_at(state, t_s + STEP_S);
         }
         let [ego, obstacle] = states;
         out.ego_min_speed_mps = out.ego_min_speed_mps.min(ego.speed_mps);

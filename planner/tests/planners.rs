@@ -404,28 +404,6 @@ fn non_finite_input_is_a_typed_error() {
     ));
 }
 
-/// Moves a vehicle along its plan for `dt_s`: position and heading from the timed path, speed
-/// ramping from the current speed to the first planned speed over the first segment.
-fn advance(plan: &Plan, now: &VehicleState, t_s: f64) -> VehicleState {
-    let path = &plan.path;
-    let k = path
-        .partition_point(|p| p.t_s <= t_s)
-        .clamp(1, path.len() - 1);
-    let (a, b) = (path[k - 1], path[k]);
-    let f = ((t_s - a.t_s) / (b.t_s - a.t_s)).clamp(0.0, 1.0);
-    let speed_mps = if k == 1 {
-        now.speed_mps + f * (a.speed_mps - now.speed_mps)
-    } else {
-        a.speed_mps
-    };
-    state(
-        a.x_m + f * (b.x_m - a.x_m),
-        a.y_m + f * (b.y_m - a.y_m),
-        (b.y_m - a.y_m).atan2(b.x_m - a.x_m),
-        speed_mps,
-    )
-}
-
 /// The paper's urgent merge rolled forward kinematically along the vehicles' own plans
 /// (replanning every 0.1 s, V2V ideal): the ego must leave the ending lane before the lower
 /// edge reaches its side, and settle in the through lane.
@@ -465,7 +443,7 @@ fn ego_leaves_the_ending_lane_before_the_edge_closes_in() {
             }
             shared = plans.iter().map(|p| p.shared.clone()).collect();
             for i in 0..2 {
-                states[i] = advance(&plans[i], &states[i], t_s + 0.1);
+                states[i] = plans[i].kinematic_state_at(&states[i], t_s + 0.1);
             }
             let ego = states[0];
             let clearance = ego.y_m - 0.5 * shape.width_m - road.lower_edge_y_m(ego.x_m);
