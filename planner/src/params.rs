@@ -212,9 +212,9 @@ impl Default for PlannerParams {
             travel_time_weight: 1.0,
             speed_deviation_weight: 1.0,
             // w3 / w2 = 15 with the floor below: the obstacle gives up ≈ 1.6 m/s to open the
-            // gap. More buys little depth (w3 = 25: 13.3 instead of 13.4 m/s) and from w3 ≈ 40
-            // the non-convex term tips a perturbed merge (obstacle at 16 m/s) into the ego
-            // yielding instead (docs/reproduction.md).
+            // gap. More buys little depth (w3 = 25: 13.3 instead of 13.4 m/s) and from w3 = 30
+            // (29 holds) the non-convex term tips a perturbed merge (obstacle at 16 m/s) into
+            // the ego yielding instead (docs/reproduction.md).
             interaction_weight: 15.0,
             // The term acts out to U ≈ 0.02, about 1.3 D_min (exp(−q) = 0.02 ⇔ q = 3.9 against
             // q = 2.3 at D_min for the default fraction 0.1): a little beyond the safety
