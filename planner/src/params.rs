@@ -125,7 +125,11 @@ pub struct PlannerParams {
     /// contact distance (l + l_o)/2 ahead of it, while a vehicle ahead keeps its full
     /// speed-dependent D_min behind it: the follower is responsible for the gap (as in RSS),
     /// so a merging vehicle makes the one it cuts in front of slow down, and a leader is not
-    /// pushed above its target speed by a vehicle following it.
+    /// pushed above its target speed by a vehicle following it — as long as the follower is
+    /// not predicted to draw level. Who is ahead is decided per time slot from the predicted
+    /// positions, so being ahead is cheap for both: a vehicle predicted (at constant velocity)
+    /// to overtake makes the leader speed up to stay ahead of it, the race of PF-ISO-PRED in
+    /// docs/reproduction.md ("Where the two equilibria meet").
     pub interaction_rear_only: bool,
     /// In PF-ISO / PF-ISO-PRED, cap the speeds at max(V_target, v0 − a_max·t): the interaction
     /// term may slow a vehicle down ("slowing down in advance", as in the paper) but not push
