@@ -1,25 +1,11 @@
 //! The `merge_sim` binary as a user runs it: outputs, contracts and bad input.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn merge_sim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_merge_sim"))
-        .args(args)
-        .output()
-        .expect("merge_sim runs")
-}
+use std::path::Path;
+use std::process::Command;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+use common::{merge_sim, scratch, stderr};
 
 #[test]
 fn run_writes_json_and_csv_that_follow_the_contract() {

@@ -1,25 +1,13 @@
 //! The closed loop as a library user drives it: safety outcomes and determinism.
 
+mod common;
+
 use mergesim::planner::PlannerKind;
 use mergesim::scenarios::Scenario;
-use mergesim::sim::recording::Recorder;
-use mergesim::sim::{RunOptions, RunOutcome, World};
+use mergesim::sim::RunOutcome;
 
 fn run(scenario: &Scenario, planner: Option<PlannerKind>, keep_time_series: bool) -> RunOutcome {
-    let options = RunOptions {
-        planner_override: planner,
-        seed: 0,
-        keep_time_series,
-    };
-    World::new(
-        scenario.sim.clone(),
-        &scenario.vehicles,
-        &options,
-        Recorder::disabled(),
-    )
-    .unwrap()
-    .run(|_| {})
-    .unwrap()
+    common::simulate(scenario, planner, 0, keep_time_series)
 }
 
 #[test]

@@ -9,10 +9,11 @@
 //! positions in the path integration, and a 3 s following gap (docs/reproduction.md,
 //! "Calibration").
 
+mod common;
+
 use mergesim::planner::PlannerKind;
 use mergesim::scenarios::Scenario;
-use mergesim::sim::recording::Recorder;
-use mergesim::sim::{RunOptions, RunOutcome, TimeSeriesRow, World};
+use mergesim::sim::{RunOutcome, TimeSeriesRow};
 
 const EGO: &str = "ego";
 const OBSTACLE: &str = "obstacle";
@@ -21,20 +22,7 @@ const OBSTACLE: &str = "obstacle";
 const SLOWING_THRESHOLD_MPS: f64 = 0.1;
 
 fn run(scenario: &Scenario, kind: PlannerKind) -> RunOutcome {
-    let options = RunOptions {
-        planner_override: Some(kind),
-        seed: 0,
-        keep_time_series: true,
-    };
-    World::new(
-        scenario.sim.clone(),
-        &scenario.vehicles,
-        &options,
-        Recorder::disabled(),
-    )
-    .unwrap()
-    .run(|_| {})
-    .unwrap()
+    common::simulate(scenario, Some(kind), 0, true)
 }
 
 /// `[PF-CS, PF-SP, PF-ISO, PF-ISO-PRED]` on one scenario, two at a time (two cores).

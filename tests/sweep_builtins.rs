@@ -1,26 +1,14 @@
 //! The built-in scenarios as sweeps use them: every one, nominal and randomised, starts and runs
 //! cleanly, and the merges that PF-ISO is meant to handle end without collision at nominal.
 
+mod common;
+
 use mergesim::planner::PlannerKind;
 use mergesim::scenarios::{Scenario, builtin};
-use mergesim::sim::recording::Recorder;
-use mergesim::sim::{RunOptions, RunOutcome, World};
+use mergesim::sim::RunOutcome;
 
 fn run(scenario: &Scenario, planner: Option<PlannerKind>, seed: u64) -> RunOutcome {
-    let options = RunOptions {
-        planner_override: planner,
-        seed,
-        keep_time_series: false,
-    };
-    World::new(
-        scenario.sim.clone(),
-        &scenario.vehicles,
-        &options,
-        Recorder::disabled(),
-    )
-    .unwrap_or_else(|e| panic!("{}: {e}", scenario.name))
-    .run(|_| {})
-    .unwrap_or_else(|e| panic!("{}: {e}", scenario.name))
+    common::simulate(scenario, planner, seed, false)
 }
 
 #[test]
@@ -74,15 +62,7 @@ fn pf_iso_merges_the_two_lane_builtins_without_collision_at_nominal() {
         "dense_merge",
     ] {
         let s = Scenario::load(name).unwrap();
-        let options = RunOptions {
-            planner_override: Some(PlannerKind::PfIso),
-            seed: 0,
-            keep_time_series: true,
-        };
-        let outcome = World::new(s.sim.clone(), &s.vehicles, &options, Recorder::disabled())
-            .unwrap()
-            .run(|_| {})
-            .unwrap();
+        let outcome = common::simulate(&s, Some(PlannerKind::PfIso), 0, true);
         assert!(
             outcome.safety.collisions.is_empty() && outcome.safety.edge_contacts.is_empty(),
             "{name}: {:?}",
