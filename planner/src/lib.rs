@@ -11,6 +11,8 @@ pub mod error;
 pub mod fallback;
 pub mod local_path;
 pub mod obstacle_field;
+pub mod others;
+pub mod parameter_set;
 pub mod params;
 pub mod planners;
 pub mod polyline;
@@ -22,7 +24,8 @@ pub mod speed_optimisation;
 pub mod types;
 
 pub use error::PlannerError;
-pub use params::PlannerParams;
+pub use parameter_set::ParameterSet;
+pub use params::{PlannerParams, SlpReading};
 pub use planners::{PfPlanner, PlanRequest, PlanStats, PlannerKind};
 pub use potential_field::{GridSpec, PotentialField};
 pub use road::{Lane, MergeRoad};

@@ -1,26 +1,120 @@
 //! Obstacle potential field, paper Eq. 4: an ellipse-shaped Gaussian around another vehicle,
 //! aligned with its heading ψ_o.
 //!
-//! Readings of the paper (listed in `planner/README.md`):
-//! - The C1/C2 terms of Eq. 4 are a small-angle form of a rotated Gaussian (and divide by σ
-//!   instead of σ²). We evaluate the Gaussian exactly in the obstacle's frame:
-//!   u = R(ψ_o)ᵀ (p − p_o), U = A_obs · exp(−u_x²/(2σ_x²) − u_y²/(2σ_y²)).
-//! - σ_y = d_lat / √(−2 ln(ε/A_obs)): the field is ε at a fixed lateral safety distance d_lat
-//!   (the paper's σ_y contains Y − Y_o itself, which makes the "Gaussian" a constant).
-//! - σ_x = D_min / √(−2 ln f): the field is the fraction f of A_obs at D_min (the paper's
-//!   σ_x = D_min √(−1/ln U) without the factor 2 and with U undefined).
-//! - D_min = (l + l_o)/2 + max(0, v_f·τ + M_f v_f²/(2 a_f) − M_l v_l²/(2 a_l)), with the body
-//!   lengths (the paper's wheelbases would let the boxes overlap at D_min), masses as
-//!   dimensionless factors, and the follower/leader roles taken from the side of the obstacle
-//!   the point is on: behind it the planning vehicle follows, ahead of it the obstacle follows.
-//!   The paper's formula is the "behind" case with τ = 0. The two half-Gaussians join with
-//!   zero slope at u_x = 0, so the field stays C¹ (and ln U stays concave in u).
+//! Eq. 4 as printed:
+//!
+//! ```text
+//!   U_OB = A_obs exp[ −C1/2 ( (X − X_o)²/σ_x + (Y − Y_o)²/σ_y − C2 ) ]
+//!   C1 = 1 − ψ_o²,   C2 = 2 ψ_o (X − X_o)(Y − Y_o) / (σ_x σ_y)
+//!   σ_x = D_min √(−1/ln U),   σ_y = √( −(Y − Y_o)² / (2 ln(ε/A_obs)) )
+//!   D_min = M v²/(2 a_b) − M_o v_o²/(2 a_b,o) + (l_fr + l_fr,o)/2
+//! ```
+//!
+//! Two readings of the heading terms, both runnable ([`HeadingForm`]):
+//! - [`HeadingForm::PaperCorrelation`] (the `paper` parameter set): C1/C2 taken as printed, with
+//!   σ read as a standard deviation (σ² under the squares, as the σ_xσ_y of C2 implies). That is
+//!   a bivariate Gaussian in world coordinates whose correlation is ψ_o, scaled by C1 = 1 − ψ_o²:
+//!   q = C1/2 · (dx²/σ_x² + dy²/σ_y² − 2 ψ_o dx dy/(σ_x σ_y)). The correlation tilts the ellipse
+//!   only by about ψ_o σ_y/σ_x, not by ψ_o; |ψ_o| is capped at [`MAX_CORRELATION_HEADING_RAD`]
+//!   so the form stays positive definite (never reached on a highway).
+//! - [`HeadingForm::Rotation`] (the `mergesim` set): the exact Gaussian in the obstacle's frame,
+//!   u = R(ψ_o)ᵀ (p − p_o), q = u_x²/(2σ_x²) + u_y²/(2σ_y²): a true rotation by ψ_o.
+//!
+//! Readings common to both sets (listed in `planner/README.md`):
+//! - σ_y = d_lat / √(−2 ln(ε/A_obs)): the field is ε at a fixed lateral safety distance d_lat.
+//!   The printed σ_y contains Y − Y_o itself: with σ_y² under the square the lateral term is the
+//!   constant 2 ln(A/ε) (no lateral decay at all); with σ_y as printed (not squared) it is
+//!   |Y − Y_o|·√(2 ln(A/ε)), an exponential profile whose length scale is a unit slip (1 m).
+//!   Neither gives a field that decays over a chosen distance, so both sets fix d_lat.
+//! - σ_x = D_min / √(−2 ln f): the field is the fraction f of A_obs at D_min (the printed
+//!   σ_x = D_min √(−1/ln U) has U undefined and lacks the factor 2).
+//! - D_min is clamped to at least its length term (a negative D_min would flip the field).
+//!   Optional extensions, all off in the `paper` set: a time gap v_f·τ; the length term from the
+//!   body lengths instead of the wheelbases ([`MinDistanceLength`]); roles by side: behind the
+//!   obstacle the planning vehicle follows (the paper's case), ahead of it the obstacle follows
+//!   (with `by_side = false` the planning vehicle is the follower on both sides, as printed).
+//!   With the rotation form the two half-Gaussians join with zero slope at u_x = 0 (C¹ field).
+//!   With the correlation form the side is the sign of X − X_o, where q is continuous.
 
-use crate::params::PlannerParams;
+use serde::{Deserialize, Serialize};
+
 use crate::types::VehicleShape;
 
-/// D_min of Eq. 4 for a follower closing on a leader (m), clamped to at least the half
-/// lengths: (l_f + l_l)/2 + max(0, v_f τ + M_f v_f²/(2 a_f) − M_l v_l²/(2 a_l)).
+/// Largest |ψ_o| used in the correlation form (rad): C1 = 1 − ψ² and the correlation ψ must stay
+/// below 1 for the quadratic form to be positive definite.
+pub const MAX_CORRELATION_HEADING_RAD: f64 = 0.9;
+
+/// How Eq. 4 aligns the ellipse with the obstacle's heading (module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum HeadingForm {
+    /// Eq. 4's C1/C2 terms as printed: a Gaussian with correlation ψ_o (the `paper` set).
+    PaperCorrelation,
+    /// The Gaussian evaluated in the obstacle's frame, rotated by ψ_o (the `mergesim` set).
+    Rotation,
+}
+
+/// Which length enters D_min's constant term (l_fr + l_fr,o)/2 (module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MinDistanceLength {
+    /// The wheelbases l_fr, as printed (the `paper` set): at D_min the bodies overlap.
+    Wheelbase,
+    /// The body lengths (the `mergesim` set): D_min is at least the contact distance.
+    BodyLength,
+}
+
+impl MinDistanceLength {
+    /// (l + l_o)/2 for the chosen length (m).
+    pub fn half_sum_m(self, me: &VehicleShape, other: &VehicleShape) -> f64 {
+        match self {
+            MinDistanceLength::Wheelbase => 0.5 * (me.wheelbase_m + other.wheelbase_m),
+            MinDistanceLength::BodyLength => 0.5 * (me.length_m + other.length_m),
+        }
+    }
+}
+
+/// The numbers that shape one family of obstacle fields (Eq. 4). The path field (Eq. 7, and
+/// PF-SP's risk) and the interaction term (Eq. 10) each have their own, so tuning one never
+/// moves the other (`PlannerParams::path_field`, `PlannerParams::interaction_field`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ObstacleFieldParams {
+    /// A_obs, the peak.
+    pub amplitude: f64,
+    /// ε, the level at the lateral safety distance.
+    pub epsilon: f64,
+    /// Lateral safety distance d_lat (m): σ_y = d_lat/√(−2 ln(ε/A)).
+    pub lateral_safety_m: f64,
+    /// Fraction f of A_obs left at D_min: σ_x = D_min/√(−2 ln f).
+    pub fraction_at_min_distance: f64,
+    /// Time gap τ added to D_min for the follower, v_f·τ (s).
+    pub time_gap_s: f64,
+    /// M of the planning vehicle (dimensionless factor).
+    pub ego_mass_factor: f64,
+    /// M_o of the other vehicle (dimensionless factor).
+    pub other_mass_factor: f64,
+    /// Heading terms of Eq. 4.
+    pub heading_form: HeadingForm,
+    /// Length term of D_min.
+    pub min_distance_length: MinDistanceLength,
+    /// Roles by side (true) or the planning vehicle always the follower (false, as printed).
+    pub min_distance_by_side: bool,
+}
+
+impl ObstacleFieldParams {
+    /// √(−2 ln f): σ_x = D_min / this.
+    pub fn x_scale(&self) -> f64 {
+        (-2.0 * self.fraction_at_min_distance.ln()).sqrt()
+    }
+
+    /// σ_y (m).
+    pub fn sigma_lateral_m(&self) -> f64 {
+        self.lateral_safety_m / (-2.0 * (self.epsilon / self.amplitude).ln()).sqrt()
+    }
+}
+
+/// D_min of Eq. 4 for a follower closing on a leader (m), clamped to at least the length term:
+/// length + max(0, v_f τ + M_f v_f²/(2 a_f) − M_l v_l²/(2 a_l)).
 #[allow(clippy::too_many_arguments)]
 pub fn min_distance_m(
     follower_speed_mps: f64,
@@ -29,14 +123,119 @@ pub fn min_distance_m(
     leader_speed_mps: f64,
     leader_decel_mps2: f64,
     leader_mass_factor: f64,
-    half_lengths_m: f64,
+    length_term_m: f64,
+    time_gap_s: f64,
+) -> f64 {
+    length_term_m
+        + min_distance_excess_m(
+            follower_speed_mps,
+            follower_decel_mps2,
+            follower_mass_factor,
+            leader_speed_mps,
+            leader_decel_mps2,
+            leader_mass_factor,
+            time_gap_s,
+        )
+        .max(0.0)
+}
+
+/// v_f τ + M_f v_f²/(2 a_f) − M_l v_l²/(2 a_l), before the clamp (m).
+fn min_distance_excess_m(
+    follower_speed_mps: f64,
+    follower_decel_mps2: f64,
+    follower_mass_factor: f64,
+    leader_speed_mps: f64,
+    leader_decel_mps2: f64,
+    leader_mass_factor: f64,
     time_gap_s: f64,
 ) -> f64 {
     let vf = follower_speed_mps.max(0.0);
     let vl = leader_speed_mps.max(0.0);
-    let braking = follower_mass_factor * vf * vf / (2.0 * follower_decel_mps2.max(1e-3))
-        - leader_mass_factor * vl * vl / (2.0 * leader_decel_mps2.max(1e-3));
-    half_lengths_m + (vf * time_gap_s + braking).max(0.0)
+    vf * time_gap_s + follower_mass_factor * vf * vf / (2.0 * follower_decel_mps2.max(1e-3))
+        - leader_mass_factor * vl * vl / (2.0 * leader_decel_mps2.max(1e-3))
+}
+
+/// What the planning vehicle knows about itself for D_min.
+#[derive(Clone, Copy, Debug)]
+pub struct SelfView {
+    /// Its speed (m/s).
+    pub speed_mps: f64,
+    /// Its shape.
+    pub shape: VehicleShape,
+}
+
+/// The two D_min of a pair, and their derivatives with respect to the planning vehicle's speed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MinDistances {
+    /// D_min behind the obstacle (the planning vehicle follows it) (m).
+    pub rear_m: f64,
+    /// D_min ahead of the obstacle (it follows the planning vehicle; = `rear_m` without roles).
+    pub front_m: f64,
+    /// ∂rear/∂v of the planning vehicle (s).
+    pub rear_dv_s: f64,
+    /// ∂front/∂v of the planning vehicle (s).
+    pub front_dv_s: f64,
+}
+
+/// D_min on both sides of an obstacle moving at `other_speed_mps`, seen by `me` (module doc).
+pub fn min_distances(
+    params: &ObstacleFieldParams,
+    me: SelfView,
+    other_speed_mps: f64,
+    other_shape: &VehicleShape,
+) -> MinDistances {
+    let length_m = params.min_distance_length.half_sum_m(&me.shape, other_shape);
+    let (a_me, a_other) = (
+        me.shape.max_brake_decel_mps2,
+        other_shape.max_brake_decel_mps2,
+    );
+    let v = me.speed_mps.max(0.0);
+    // Behind the obstacle: I follow it.
+    let rear_excess = min_distance_excess_m(
+        v,
+        a_me,
+        params.ego_mass_factor,
+        other_speed_mps,
+        a_other,
+        params.other_mass_factor,
+        params.time_gap_s,
+    );
+    let rear_m = length_m + rear_excess.max(0.0);
+    let rear_dv_s = if rear_excess > 0.0 && me.speed_mps > 0.0 {
+        params.time_gap_s + params.ego_mass_factor * v / a_me.max(1e-3)
+    } else {
+        0.0
+    };
+    if !params.min_distance_by_side {
+        return MinDistances {
+            rear_m,
+            front_m: rear_m,
+            rear_dv_s,
+            front_dv_s: rear_dv_s,
+        };
+    }
+    // Ahead of the obstacle: it follows me.
+    let front_excess = min_distance_excess_m(
+        other_speed_mps,
+        a_other,
+        params.other_mass_factor,
+        v,
+        a_me,
+        params.ego_mass_factor,
+        params.time_gap_s,
+    );
+    let front_m = length_m + front_excess.max(0.0);
+    let front_dv_s = if front_excess > 0.0 && me.speed_mps > 0.0 {
+        -params.ego_mass_factor * v / a_me.max(1e-3)
+    } else {
+        0.0
+    };
+    MinDistances {
+        rear_m,
+        front_m,
+        rear_dv_s,
+        front_dv_s,
+    }
 }
 
 /// One obstacle's field (Eq. 4) as seen by one planning vehicle.
@@ -50,6 +249,8 @@ pub struct ObstacleField {
     pub cos_heading: f64,
     /// sin ψ_o.
     pub sin_heading: f64,
+    /// ψ_o (rad), capped for the correlation form.
+    pub heading_rad: f64,
     /// σ_x ahead of the obstacle (m).
     pub sigma_front_m: f64,
     /// σ_x behind the obstacle (m).
@@ -58,22 +259,35 @@ pub struct ObstacleField {
     pub sigma_lateral_m: f64,
     /// A_obs.
     pub amplitude: f64,
+    /// Heading terms.
+    pub heading_form: HeadingForm,
 }
 
-/// What the planning vehicle knows about itself for D_min.
-#[derive(Clone, Copy, Debug)]
-pub struct SelfView {
-    /// Its speed (m/s).
-    pub speed_mps: f64,
-    /// Its shape.
-    pub shape: VehicleShape,
+/// Who keeps the gap between the planning vehicle and another one (module doc of `others`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Role {
+    /// The full by-side field.
+    Full,
+    /// The front shrunk to the contact distance (the other follows me where I am ahead of it).
+    RearOnly,
+    /// Both halves at the contact distance (I lead; the other keeps the gap).
+    ContactOnly,
+}
+
+/// Which half of the field a point lies in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// Ahead of the obstacle (σ_front).
+    Front,
+    /// Behind it (σ_rear).
+    Rear,
 }
 
 impl ObstacleField {
     /// The field of a vehicle at (x, y, ψ) with `other_speed_mps` and `other_shape`, seen by
     /// the planning vehicle `me` (σ's as in the module doc).
     pub fn new(
-        params: &PlannerParams,
+        params: &ObstacleFieldParams,
         me: SelfView,
         x_m: f64,
         y_m: f64,
@@ -81,52 +295,50 @@ impl ObstacleField {
         other_speed_mps: f64,
         other_shape: &VehicleShape,
     ) -> Self {
-        let half_lengths_m = 0.5 * (me.shape.length_m + other_shape.length_m);
-        // Behind the obstacle: I follow it.
-        let d_rear = min_distance_m(
-            me.speed_mps,
-            me.shape.max_brake_decel_mps2,
-            params.ego_mass_factor,
-            other_speed_mps,
-            other_shape.max_brake_decel_mps2,
-            params.other_mass_factor,
-            half_lengths_m,
-            params.obstacle_time_gap_s,
-        );
-        // Ahead of the obstacle: it follows me.
-        let d_front = min_distance_m(
-            other_speed_mps,
-            other_shape.max_brake_decel_mps2,
-            params.other_mass_factor,
-            me.speed_mps,
-            me.shape.max_brake_decel_mps2,
-            params.ego_mass_factor,
-            half_lengths_m,
-            params.obstacle_time_gap_s,
-        );
-        let x_scale = (-2.0 * params.obstacle_fraction_at_min_distance.ln()).sqrt();
-        let y_scale = (-2.0 * (params.obstacle_epsilon / params.obstacle_amplitude).ln()).sqrt();
+        let d = min_distances(params, me, other_speed_mps, other_shape);
+        let x_scale = params.x_scale();
         let (sin_heading, cos_heading) = heading_rad.sin_cos();
         Self {
             x_m,
             y_m,
             cos_heading,
             sin_heading,
-            sigma_front_m: d_front / x_scale,
-            sigma_rear_m: d_rear / x_scale,
-            sigma_lateral_m: params.obstacle_lateral_safety_m / y_scale,
-            amplitude: params.obstacle_amplitude,
+            heading_rad: cap_heading(heading_rad),
+            sigma_front_m: d.front_m / x_scale,
+            sigma_rear_m: d.rear_m / x_scale,
+            sigma_lateral_m: params.sigma_lateral_m(),
+            amplitude: params.amplitude,
+            heading_form: params.heading_form,
         }
     }
 
     /// The same field with its front half shrunk to the contact distance (l + l_o)/2: only the
     /// vehicle behind keeps the speed-dependent gap (the follower is responsible for it, as in
     /// RSS). Used by the interaction term of Eq. 10 when `interaction_rear_only` is set.
-    pub fn rear_only(&self, half_lengths_m: f64, params: &PlannerParams) -> Self {
-        let x_scale = (-2.0 * params.obstacle_fraction_at_min_distance.ln()).sqrt();
+    pub fn rear_only(&self, contact_m: f64, x_scale: f64) -> Self {
         Self {
-            sigma_front_m: half_lengths_m / x_scale,
+            sigma_front_m: contact_m / x_scale,
             ..*self
+        }
+    }
+
+    /// The same field shrunk to the contact distance on both sides: what a leader sees of the
+    /// vehicle behind it when the roles are fixed from the order now (the follower keeps the
+    /// gap, however their predicted positions develop).
+    pub fn contact_only(&self, contact_m: f64, x_scale: f64) -> Self {
+        Self {
+            sigma_front_m: contact_m / x_scale,
+            sigma_rear_m: contact_m / x_scale,
+            ..*self
+        }
+    }
+
+    /// The field with `role` applied ([`Role::Full`] leaves it as it is).
+    pub fn with_role(&self, role: Role, contact_m: f64, x_scale: f64) -> Self {
+        match role {
+            Role::Full => *self,
+            Role::RearOnly => self.rear_only(contact_m, x_scale),
+            Role::ContactOnly => self.contact_only(contact_m, x_scale),
         }
     }
 
@@ -137,29 +349,61 @@ impl ObstacleField {
             y_m,
             cos_heading,
             sin_heading,
+            heading_rad: cap_heading(sin_heading.atan2(cos_heading)),
             ..*self
         }
     }
 
-    /// (u_x, u_y, σ_x): the point in the obstacle's frame and the σ_x of its side.
-    fn local(&self, x_m: f64, y_m: f64) -> (f64, f64, f64) {
+    /// The side of the field a point is on.
+    pub fn side(&self, x_m: f64, y_m: f64) -> Side {
+        let dx = x_m - self.x_m;
+        let along = match self.heading_form {
+            HeadingForm::Rotation => self.cos_heading * dx + self.sin_heading * (y_m - self.y_m),
+            HeadingForm::PaperCorrelation => dx,
+        };
+        if along >= 0.0 { Side::Front } else { Side::Rear }
+    }
+
+    /// The exponent q (U = A·exp(−q)) and ∂q/∂x, ∂q/∂y and ∂q/∂σ_x of the point's side.
+    fn exponent_and_derivatives(&self, x_m: f64, y_m: f64) -> (f64, [f64; 2], f64) {
         let dx = x_m - self.x_m;
         let dy = y_m - self.y_m;
-        let ux = self.cos_heading * dx + self.sin_heading * dy;
-        let uy = -self.sin_heading * dx + self.cos_heading * dy;
-        let sigma_x = if ux >= 0.0 {
-            self.sigma_front_m
-        } else {
-            self.sigma_rear_m
+        let sx = match self.side(x_m, y_m) {
+            Side::Front => self.sigma_front_m,
+            Side::Rear => self.sigma_rear_m,
         };
-        (ux, uy, sigma_x)
+        let sy = self.sigma_lateral_m;
+        match self.heading_form {
+            HeadingForm::Rotation => {
+                let ux = self.cos_heading * dx + self.sin_heading * dy;
+                let uy = -self.sin_heading * dx + self.cos_heading * dy;
+                let q = 0.5 * (ux * ux / (sx * sx) + uy * uy / (sy * sy));
+                // dq/du = (u_x/σ_x², u_y/σ_y²); du/dp = R(ψ)ᵀ.
+                let qx = ux / (sx * sx);
+                let qy = uy / (sy * sy);
+                let grad = [
+                    qx * self.cos_heading - qy * self.sin_heading,
+                    qx * self.sin_heading + qy * self.cos_heading,
+                ];
+                let d_sigma = -ux * ux / (sx * sx * sx);
+                (q, grad, d_sigma)
+            }
+            HeadingForm::PaperCorrelation => {
+                let psi = self.heading_rad;
+                let c1 = 1.0 - psi * psi;
+                let (a, b, c) = (1.0 / (sx * sx), 1.0 / (sy * sy), psi / (sx * sy));
+                let q = 0.5 * c1 * (a * dx * dx + b * dy * dy - 2.0 * c * dx * dy);
+                let grad = [c1 * (a * dx - c * dy), c1 * (b * dy - c * dx)];
+                // ∂a/∂σ_x = −2/σ_x³, ∂c/∂σ_x = −c/σ_x.
+                let d_sigma = 0.5 * c1 * (-2.0 * dx * dx / (sx * sx * sx) + 2.0 * c * dx * dy / sx);
+                (q, grad, d_sigma)
+            }
+        }
     }
 
     /// The exponent q with U = A·exp(−q) (q ≥ 0).
     pub fn exponent(&self, x_m: f64, y_m: f64) -> f64 {
-        let (ux, uy, sx) = self.local(x_m, y_m);
-        let sy = self.sigma_lateral_m;
-        0.5 * (ux * ux / (sx * sx) + uy * uy / (sy * sy))
+        self.exponent_and_derivatives(x_m, y_m).0
     }
 
     /// U_OB at (x, y), Eq. 4.
@@ -169,15 +413,17 @@ impl ObstacleField {
 
     /// U_OB and its gradient with respect to the evaluated point (x, y).
     pub fn value_and_gradient(&self, x_m: f64, y_m: f64) -> (f64, [f64; 2]) {
-        let (ux, uy, sx) = self.local(x_m, y_m);
-        let sy = self.sigma_lateral_m;
-        let u = self.amplitude * (-0.5 * (ux * ux / (sx * sx) + uy * uy / (sy * sy))).exp();
-        // dq/du = (u_x/σ_x², u_y/σ_y²); du/dp = R(ψ)ᵀ.
-        let qx = ux / (sx * sx);
-        let qy = uy / (sy * sy);
-        let gx = -u * (qx * self.cos_heading - qy * self.sin_heading);
-        let gy = -u * (qx * self.sin_heading + qy * self.cos_heading);
-        (u, [gx, gy])
+        let (q, dq, _) = self.exponent_and_derivatives(x_m, y_m);
+        let u = self.amplitude * (-q).exp();
+        (u, [-u * dq[0], -u * dq[1]])
+    }
+
+    /// U_OB, the side, and ∂U/∂σ_x of that side at a fixed point (the paper's reading of
+    /// U_SLP, where speed enters only through D_min).
+    pub fn value_and_sigma_derivative(&self, x_m: f64, y_m: f64) -> (f64, Side, f64) {
+        let (q, _, dq_dsigma) = self.exponent_and_derivatives(x_m, y_m);
+        let u = self.amplitude * (-q).exp();
+        (u, self.side(x_m, y_m), -u * dq_dsigma)
     }
 
     /// ∇U_OB at (x, y).
@@ -186,9 +432,16 @@ impl ObstacleField {
     }
 }
 
+fn cap_heading(heading_rad: f64) -> f64 {
+    let wrapped = (heading_rad + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+        - std::f64::consts::PI;
+    wrapped.clamp(-MAX_CORRELATION_HEADING_RAD, MAX_CORRELATION_HEADING_RAD)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::PlannerParams;
 
     fn me(speed_mps: f64) -> SelfView {
         SelfView {
@@ -197,55 +450,98 @@ mod tests {
         }
     }
 
+    fn forms() -> [ObstacleFieldParams; 2] {
+        let rotation = PlannerParams::default().path_field();
+        let paper = ObstacleFieldParams {
+            heading_form: HeadingForm::PaperCorrelation,
+            min_distance_by_side: false,
+            min_distance_length: MinDistanceLength::Wheelbase,
+            time_gap_s: 0.0,
+            ..rotation
+        };
+        [rotation, paper]
+    }
+
     #[test]
-    fn gradient_matches_central_differences_in_a_rotated_frame() {
-        let params = PlannerParams::default();
-        let field = ObstacleField::new(
-            &params,
-            me(20.0),
-            30.0,
-            5.0,
-            0.4,
-            15.0,
-            &VehicleShape::default(),
-        );
-        assert!(field.sigma_front_m != field.sigma_rear_m);
-        let h = 1e-6;
-        for (x, y) in [
-            (25.0, 4.0),
-            (36.0, 6.5),
-            (30.5, 3.0),
-            (10.0, 5.0),
-            (45.0, 9.0),
-        ] {
-            let g = field.gradient(x, y);
-            let fx = (field.value(x + h, y) - field.value(x - h, y)) / (2.0 * h);
-            let fy = (field.value(x, y + h) - field.value(x, y - h)) / (2.0 * h);
-            assert!((g[0] - fx).abs() < 1e-7, "({x},{y}): {} vs {fx}", g[0]);
-            assert!((g[1] - fy).abs() < 1e-7, "({x},{y}): {} vs {fy}", g[1]);
+    fn gradient_matches_central_differences_in_both_forms() {
+        for params in forms() {
+            let field = ObstacleField::new(
+                &params,
+                me(20.0),
+                30.0,
+                5.0,
+                0.4,
+                15.0,
+                &VehicleShape::default(),
+            );
+            let h = 1e-6;
+            for (x, y) in [
+                (25.0, 4.0),
+                (36.0, 6.5),
+                (30.5, 3.0),
+                (10.0, 5.0),
+                (45.0, 9.0),
+            ] {
+                let g = field.gradient(x, y);
+                let fx = (field.value(x + h, y) - field.value(x - h, y)) / (2.0 * h);
+                let fy = (field.value(x, y + h) - field.value(x, y - h)) / (2.0 * h);
+                assert!((g[0] - fx).abs() < 1e-7, "({x},{y}): {} vs {fx}", g[0]);
+                assert!((g[1] - fy).abs() < 1e-7, "({x},{y}): {} vs {fy}", g[1]);
+            }
+        }
+    }
+
+    #[test]
+    fn sigma_derivative_matches_central_differences_in_both_forms() {
+        for params in forms() {
+            let field = ObstacleField::new(
+                &params,
+                me(20.0),
+                0.0,
+                0.0,
+                0.2,
+                15.0,
+                &VehicleShape::default(),
+            );
+            let h = 1e-6;
+            for (x, y) in [(-8.0, 0.5), (6.0, -0.4), (-20.0, 1.0)] {
+                let (_, side, du) = field.value_and_sigma_derivative(x, y);
+                let shifted = |d: f64| {
+                    let mut f = field;
+                    match side {
+                        Side::Front => f.sigma_front_m += d,
+                        Side::Rear => f.sigma_rear_m += d,
+                    }
+                    f.value(x, y)
+                };
+                let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
+                assert!((du - fd).abs() < 1e-7, "({x},{y}): {du} vs {fd}");
+            }
         }
     }
 
     #[test]
     fn field_levels_match_the_safety_distances() {
-        let params = PlannerParams::default();
+        let params = PlannerParams {
+            obstacle_time_gap_s: 2.0,
+            ..PlannerParams::default()
+        }
+        .path_field();
         let shape = VehicleShape::default();
         let field = ObstacleField::new(&params, me(20.0), 0.0, 0.0, 0.0, 15.0, &shape);
         // Lateral: ε at d_lat.
-        let at_lateral = field.value(0.0, params.obstacle_lateral_safety_m);
-        assert!((at_lateral - params.obstacle_epsilon).abs() < 1e-12);
+        let at_lateral = field.value(0.0, params.lateral_safety_m);
+        assert!((at_lateral - params.epsilon).abs() < 1e-12);
         // Behind: the planning vehicle (20 m/s) follows the obstacle (15 m/s).
         let a = shape.max_brake_decel_mps2;
-        let d_rear = shape.length_m
-            + 20.0 * params.obstacle_time_gap_s
-            + (20.0 * 20.0 - 15.0 * 15.0) / (2.0 * a);
+        let d_rear = shape.length_m + 20.0 * 2.0 + (20.0 * 20.0 - 15.0 * 15.0) / (2.0 * a);
         let behind = field.value(-d_rear, 0.0);
-        let expected = params.obstacle_amplitude * params.obstacle_fraction_at_min_distance;
+        let expected = params.amplitude * params.fraction_at_min_distance;
         assert!((behind - expected).abs() < 1e-12, "{behind} vs {expected}");
     }
 
     #[test]
-    fn min_distance_is_clamped_to_the_half_lengths() {
+    fn min_distance_is_clamped_to_the_length_term() {
         // A much faster leader: the braking terms would make D_min negative.
         let d = min_distance_m(5.0, 7.0, 1.0, 30.0, 7.0, 1.0, 4.5, 0.0);
         assert_eq!(d, 4.5);
@@ -255,8 +551,29 @@ mod tests {
     }
 
     #[test]
+    fn paper_min_distance_has_no_roles_and_uses_wheelbases() {
+        let paper = forms()[1];
+        let shape = VehicleShape::default();
+        // The slower vehicle's view of a faster one: as printed, it is the follower on both
+        // sides, so D_min is clamped to the wheelbase term on both.
+        let d = min_distances(&paper, me(15.0), 20.0, &shape);
+        assert_eq!(d.front_m, d.rear_m);
+        assert_eq!(d.rear_m, shape.wheelbase_m);
+        assert_eq!(d.rear_dv_s, 0.0);
+        // The faster vehicle's view: v²/2a − v_o²/2a + l_fr, growing with its speed.
+        let d = min_distances(&paper, me(20.0), 15.0, &shape);
+        let a = shape.max_brake_decel_mps2;
+        assert!((d.rear_m - (shape.wheelbase_m + 175.0 / (2.0 * a))).abs() < 1e-12);
+        assert!((d.rear_dv_s - 20.0 / a).abs() < 1e-12);
+        // Roles by side (mergesim): ahead of the slower obstacle, it follows me.
+        let ours = forms()[0];
+        let d = min_distances(&ours, me(20.0), 15.0, &shape);
+        assert!(d.front_m < d.rear_m);
+    }
+
+    #[test]
     fn rotation_aligns_the_ellipse_with_the_heading() {
-        let params = PlannerParams::default();
+        let params = forms()[0];
         let shape = VehicleShape::default();
         let psi: f64 = 0.3;
         let field = ObstacleField::new(&params, me(15.0), 0.0, 0.0, psi, 15.0, &shape);
@@ -265,5 +582,34 @@ mod tests {
         let r = 4.0;
         let rotated = field.value(r * psi.cos(), r * psi.sin());
         assert!((rotated - straight.value(r, 0.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn correlation_form_tilts_far_less_than_the_heading() {
+        // The paper's C1/C2 form: along the heading the field does not stay at its on-axis
+        // value; the ellipse's major axis tilts by ≈ ψ σ_y/σ_x, a small fraction of ψ.
+        let params = forms()[1];
+        let shape = VehicleShape::default();
+        let psi: f64 = 0.1;
+        let field = ObstacleField::new(&params, me(20.0), 0.0, 0.0, psi, 15.0, &shape);
+        let r = 2.0 * field.sigma_rear_m;
+        // Lateral position of the ridge (largest U) at x = −r: for a Gaussian with correlation
+        // ρ = ψ, y* = ρ σ_y/σ_x · x.
+        let ridge_y = (-2000..=2000)
+            .map(|k| k as f64 * 1e-4)
+            .max_by(|a, b| field.value(-r, *a).total_cmp(&field.value(-r, *b)))
+            .unwrap();
+        let expected = psi * field.sigma_lateral_m / field.sigma_rear_m * (-r);
+        assert!((ridge_y - expected).abs() < 2e-4, "{ridge_y} vs {expected}");
+        assert!(ridge_y.abs() < 0.2 * (psi * r).abs(), "a rotation would put it at −ψ r");
+        // At ψ = 0 both forms agree.
+        let rotation = ObstacleField::new(&forms()[0], me(15.0), 0.0, 0.0, 0.0, 15.0, &shape);
+        let paper = ObstacleField {
+            heading_form: HeadingForm::PaperCorrelation,
+            ..rotation
+        };
+        for (x, y) in [(3.0, 0.4), (-7.0, -0.2)] {
+            assert!((rotation.value(x, y) - paper.value(x, y)).abs() < 1e-15);
+        }
     }
 }

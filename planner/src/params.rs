@@ -8,6 +8,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::PlannerError;
+use crate::obstacle_field::{HeadingForm, MinDistanceLength, ObstacleFieldParams};
+use crate::prediction::PredictionModel;
 
 /// Smallest number of waypoints: a cubic has four coefficients (paper, after Eq. 9).
 pub const MIN_WAYPOINTS: usize = 4;
@@ -17,6 +19,17 @@ pub const MAX_WAYPOINTS: usize = 200;
 
 /// Standard gravity g (m/s²) of the friction speed limit √(μ g / |κ|) (Eq. 10a).
 pub const GRAVITY_MPS2: f64 = 9.806_65;
+
+/// Where the interaction term of Eq. 10 evaluates U_SLP (see `PlannerParams::interaction_slp_reading`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SlpReading {
+    /// At the ego's Eq. 7 waypoint i and the other's SLP at the same time: speed enters only
+    /// through D_min(v_i) (the paper's text, and the `paper` set).
+    FixedWaypoints,
+    /// At the ego's position after i time slots at the planned speeds (the `mergesim` set).
+    ArcLength,
+}
 
 /// Parameters of the potential-field planner (paper Eqs. 1–10).
 ///
@@ -62,6 +75,16 @@ pub struct PlannerParams {
     pub ego_mass_factor: f64,
     /// M_o of the other vehicle in D_min, as a dimensionless factor.
     pub other_mass_factor: f64,
+    /// How Eq. 4 aligns an obstacle's ellipse with its heading: `paper-correlation` (the C1/C2
+    /// terms as printed, a Gaussian with correlation ψ_o) or `rotation` (the Gaussian in the
+    /// obstacle's frame). Shared by the path field and the interaction term.
+    pub obstacle_heading_form: HeadingForm,
+    /// The length term (l + l_o)/2 of D_min: `wheelbase` (as printed; the bodies overlap at
+    /// D_min) or `body-length` (D_min is at least the contact distance). Shared.
+    pub obstacle_min_distance_length: MinDistanceLength,
+    /// D_min with roles by side (ahead of the obstacle it is the follower) instead of the
+    /// planning vehicle always being the follower, as printed. Shared.
+    pub obstacle_min_distance_by_side: bool,
 
     // ---------------------------------------------------------------- Eq. 7 (waypoints)
     /// N, number of waypoints (≥ 4).
@@ -121,6 +144,27 @@ pub struct PlannerParams {
     /// ln U pull hardest near the ε contour, i.e. at 3–4 σ_x, so vehicles at a safe following
     /// distance keep pushing each other's speeds away from their targets.
     pub interaction_floor: f64,
+    /// Time gap τ_I of the follower's D_min in the interaction term (s); the path field's is
+    /// `obstacle_time_gap_s`. Separate, so tuning the interaction never moves PF-CS or PF-SP.
+    pub interaction_time_gap_s: f64,
+    /// ε_I of the interaction term's σ_y: its field's level at `interaction_lateral_safety_m`
+    /// (the path field's is `obstacle_epsilon`).
+    pub interaction_epsilon: f64,
+    /// Lateral safety distance of the interaction term's σ_y (m).
+    pub interaction_lateral_safety_m: f64,
+    /// Fraction of A_obs left at D_min in the interaction term (fixes its σ_x).
+    pub interaction_fraction_at_min_distance: f64,
+    /// Where U_SLP is evaluated: `fixed-waypoints` (the paper's reading: at the ego's Eq. 7
+    /// waypoint i against the other's i-th shared waypoint, so speed enters only through
+    /// D_min(v_i)) or `arc-length` (at the ego's position after i slots at the planned speeds,
+    /// s_i = Δt Σ_{j ≤ i} v_j, against the other's SLP at the same time).
+    pub interaction_slp_reading: SlpReading,
+    /// For a vehicle whose motion is *predicted* (no fresh shared path: PF-ISO-PRED, PF-SP,
+    /// PF-ISO's fallback), fix the roles from the order now: a vehicle behind counts only at
+    /// the contact distance, one ahead with its full D_min on both sides, whatever the
+    /// prediction says about who will lead. A received shared path is the sender's declared
+    /// intent and keeps the per-slot roles of `interaction_rear_only`.
+    pub interaction_roles_from_order_now: bool,
     /// In the interaction term, a vehicle behind the planning vehicle counts only within the
     /// contact distance (l + l_o)/2 ahead of it, while a vehicle ahead keeps its full
     /// speed-dependent D_min behind it: the follower is responsible for the gap (as in RSS),
@@ -157,9 +201,17 @@ pub struct PlannerParams {
     pub solver_max_iterations: u32,
     /// Clarabel's gap and feasibility tolerances.
     pub solver_tolerance: f64,
-    /// A shared local path older than this is ignored in favour of a constant-velocity
-    /// prediction (s).
+    /// A shared local path older than this is ignored in favour of a prediction (s).
     pub max_shared_path_age_s: f64,
+    /// How a vehicle without a fresh shared path is predicted: `constant-velocity` (straight
+    /// along its heading) or `lane-following` (along the road at its speed, keeping its lateral
+    /// position, lifted by the tapering edge of the ending lane).
+    pub prediction: PredictionModel,
+
+    // ---------------------------------------------------------------- PF-SP (risk-aware speeds)
+    /// w_R, weight of PF-SP's risk term Σ_i U(e_i(v)): the path field of the others (Eq. 4 with
+    /// the path-field parameters), predicted without V2V, along the vehicle's own path.
+    pub risk_weight: f64,
 
     // ---------------------------------------------------------------- faults
     /// Comfortable deceleration of the fallback plan (m/s², positive).
@@ -194,6 +246,9 @@ impl Default for PlannerParams {
             obstacle_time_gap_s: 3.0,
             ego_mass_factor: 1.0,
             other_mass_factor: 1.0,
+            obstacle_heading_form: HeadingForm::Rotation,
+            obstacle_min_distance_length: MinDistanceLength::BodyLength,
+            obstacle_min_distance_by_side: true,
             waypoint_count: 20,
             // N · Δt_plan = 8 s of shared local path (160 m at 20 m/s): at t ≈ 3 s the ego's
             // SLP already reaches the merge section, which is what lets the obstacle start
@@ -224,6 +279,12 @@ impl Default for PlannerParams {
             // q = 2.3 at D_min for the default fraction 0.1): a little beyond the safety
             // distance, still fading a lane away (see `obstacle_epsilon`).
             interaction_floor: 0.02,
+            interaction_time_gap_s: 3.0,
+            interaction_epsilon: 3e-4,
+            interaction_lateral_safety_m: 3.5,
+            interaction_fraction_at_min_distance: 0.1,
+            interaction_slp_reading: SlpReading::ArcLength,
+            interaction_roles_from_order_now: false,
             interaction_rear_only: true,
             interaction_slows_only: false,
             trust_region_mps: 2.0,
@@ -236,6 +297,8 @@ impl Default for PlannerParams {
             solver_max_iterations: 50,
             solver_tolerance: 1e-7,
             max_shared_path_age_s: 0.5,
+            prediction: PredictionModel::ConstantVelocity,
+            risk_weight: 10.0,
             fallback_decel_mps2: 2.0,
         }
     }
@@ -260,6 +323,8 @@ impl PlannerParams {
             ("obstacle_amplitude", self.obstacle_amplitude),
             ("obstacle_epsilon", self.obstacle_epsilon),
             ("interaction_floor", self.interaction_floor),
+            ("interaction_epsilon", self.interaction_epsilon),
+            ("interaction_lateral_safety_m", self.interaction_lateral_safety_m),
             ("obstacle_lateral_safety_m", self.obstacle_lateral_safety_m),
             ("ego_mass_factor", self.ego_mass_factor),
             ("other_mass_factor", self.other_mass_factor),
@@ -294,6 +359,8 @@ impl PlannerParams {
             ("cubic_origin_weight", self.cubic_origin_weight),
             ("travel_time_weight", self.travel_time_weight),
             ("interaction_weight", self.interaction_weight),
+            ("interaction_time_gap_s", self.interaction_time_gap_s),
+            ("risk_weight", self.risk_weight),
             ("scp_relative_tolerance", self.scp_relative_tolerance),
             ("max_shared_path_age_s", self.max_shared_path_age_s),
             ("substep_max_turn_rad", self.substep_max_turn_rad),
@@ -310,13 +377,26 @@ impl PlannerParams {
                 "must be below planner.obstacle_amplitude (σ_y = d/√(−2 ln(ε/A)))",
             ));
         }
-        let fraction = self.obstacle_fraction_at_min_distance;
-        if !(fraction > 0.0 && fraction < 1.0) {
+        if self.interaction_epsilon >= self.obstacle_amplitude {
             return Err(invalid(
-                "obstacle_fraction_at_min_distance",
-                fraction,
-                "must lie in (0, 1)",
+                "interaction_epsilon",
+                self.interaction_epsilon,
+                "must be below planner.obstacle_amplitude (σ_y = d/√(−2 ln(ε/A)))",
             ));
+        }
+        for (name, fraction) in [
+            (
+                "obstacle_fraction_at_min_distance",
+                self.obstacle_fraction_at_min_distance,
+            ),
+            (
+                "interaction_fraction_at_min_distance",
+                self.interaction_fraction_at_min_distance,
+            ),
+        ] {
+            if !(fraction > 0.0 && fraction < 1.0) {
+                return Err(invalid(name, fraction, "must lie in (0, 1)"));
+            }
         }
         if self.cubic_max_heading_rad >= std::f64::consts::FRAC_PI_2 {
             return Err(invalid(
@@ -347,6 +427,45 @@ impl PlannerParams {
             ));
         }
         Ok(())
+    }
+
+    /// The obstacle fields of the path (Eq. 7) and of PF-SP's risk term.
+    pub fn path_field(&self) -> ObstacleFieldParams {
+        ObstacleFieldParams {
+            amplitude: self.obstacle_amplitude,
+            epsilon: self.obstacle_epsilon,
+            lateral_safety_m: self.obstacle_lateral_safety_m,
+            fraction_at_min_distance: self.obstacle_fraction_at_min_distance,
+            time_gap_s: self.obstacle_time_gap_s,
+            ..self.shared_field_readings()
+        }
+    }
+
+    /// The obstacle fields of the interaction term U_SLP (Eq. 10).
+    pub fn interaction_field(&self) -> ObstacleFieldParams {
+        ObstacleFieldParams {
+            amplitude: self.obstacle_amplitude,
+            epsilon: self.interaction_epsilon,
+            lateral_safety_m: self.interaction_lateral_safety_m,
+            fraction_at_min_distance: self.interaction_fraction_at_min_distance,
+            time_gap_s: self.interaction_time_gap_s,
+            ..self.shared_field_readings()
+        }
+    }
+
+    fn shared_field_readings(&self) -> ObstacleFieldParams {
+        ObstacleFieldParams {
+            amplitude: self.obstacle_amplitude,
+            epsilon: self.obstacle_epsilon,
+            lateral_safety_m: self.obstacle_lateral_safety_m,
+            fraction_at_min_distance: self.obstacle_fraction_at_min_distance,
+            time_gap_s: self.obstacle_time_gap_s,
+            ego_mass_factor: self.ego_mass_factor,
+            other_mass_factor: self.other_mass_factor,
+            heading_form: self.obstacle_heading_form,
+            min_distance_length: self.obstacle_min_distance_length,
+            min_distance_by_side: self.obstacle_min_distance_by_side,
+        }
     }
 
     /// The attractive pull λ·look-ahead of the moving target (1/m), the unit of force.

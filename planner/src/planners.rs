@@ -1,20 +1,21 @@
-//! The four planners behind one interface: PF-CS, PF-SP, PF-ISO and PF-ISO-PRED.
+//! The planners behind one interface: PF-CS, PF-SP, PF-ISO, and the controls PF-SP-EQ10 and
+//! PF-ISO-PRED.
 //!
 //! Every planner generates the path the same way (Eqs. 1–9); they differ in the speeds:
 //!
 //! | kind          | speeds                                                                 |
 //! |---------------|------------------------------------------------------------------------|
 //! | `pf-cs`       | constant V_target (Wang et al. 2022 baseline)                          |
-//! | `pf-sp`       | Eq. 10 with w3 = 0: travel time, target speed, friction limit (Wu et al.) |
-//! | `pf-iso`      | Eq. 10 with the received shared local paths (a constant-velocity prediction for a neighbour whose SLP is missing or stale) |
-//! | `pf-iso-pred` | Eq. 10 with every neighbour predicted at constant velocity (no V2V)   |
+//! | `pf-sp`       | risk-aware speed planning without V2V (the paper's baseline, after Wu et al. 2022): travel time, target speed and w_R Σ U along its own path, U the others' path field (Eq. 4 with the path-field parameters) at their predicted positions |
+//! | `pf-sp-eq10`  | Eq. 10 with w3 = 0: travel time, target speed, friction limit (a control: on a straight road it equals PF-CS) |
+//! | `pf-iso`      | Eq. 10 with the received shared local paths (a prediction for a neighbour whose SLP is missing or stale) |
+//! | `pf-iso-pred` | Eq. 10 with every neighbour predicted (no V2V): what V2V buys         |
 //!
 //! One planning cycle: universal field from the perceived neighbours (Eqs. 1–5) → N gradient
 //! steps of L_s = v·Δt_plan (Eqs. 6–7) → constrained cubic fit in the vehicle frame (Eqs. 8–9)
-//! → speeds (Eq. 10) → the path to track (cubic sampled at the waypoints, with speeds and
-//! absolute times t_i = t_0 + Σ_{j ≤ i} Δs_j / v_j) and the SLP to broadcast.
+//! → speeds → the path to track (cubic sampled at the waypoints, with speeds and absolute times
+//! t_i = t_0 + Σ_{j ≤ i} Δs_j / v_j) and the SLP to broadcast.
 
-use std::collections::BTreeMap;
 use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
@@ -23,14 +24,13 @@ use crate::cubic_fit::{FitMethod, fit_path_cubic};
 use crate::error::PlannerError;
 use crate::fallback::{FallbackInput, fallback_plan};
 use crate::local_path::local_path_adaptive;
-use crate::obstacle_field::{ObstacleField, SelfView};
-use crate::params::PlannerParams;
+use crate::others::{RoleRules, arc_length_term, fixed_waypoint_term, gather_others};
+use crate::params::{PlannerParams, SlpReading};
 use crate::polyline::Polyline;
 use crate::potential_field::{GridSpec, PotentialField};
-use crate::prediction::Trajectory;
 use crate::road::MergeRoad;
 use crate::speed_optimisation::{
-    InteractionTerm, SpeedOptimiser, SpeedProblem, friction_speed_limits,
+    Aggregate, SpeedOptimiser, SpeedProblem, SpeedTerm, friction_speed_limits,
 };
 use crate::types::{
     FallbackReason, Neighbour, PathPoint, Plan, SharedLocalPath, TimedWaypoint, VehicleId,
@@ -38,36 +38,45 @@ use crate::types::{
 };
 
 /// Which planner a vehicle runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum PlannerKind {
     /// PF path, constant speed V_target.
     PfCs,
-    /// PF path, speed planning without interaction (Eq. 10 with w3 = 0).
+    /// PF path, risk-aware speed planning without V2V (the paper's baseline).
     PfSp,
+    /// PF path, Eq. 10 with w3 = 0 (a control planner).
+    PfSpEq10,
     /// PF path, interactive speed optimisation with the shared local paths (Eq. 10).
     PfIso,
-    /// Like PF-ISO with the others' paths predicted at constant velocity (no V2V).
+    /// Like PF-ISO with the others' paths predicted (no V2V).
     PfIsoPred,
 }
 
 impl PlannerKind {
     /// Every kind, in a fixed order.
-    pub const ALL: [PlannerKind; 4] = [
+    pub const ALL: [PlannerKind; 5] = [
         PlannerKind::PfCs,
         PlannerKind::PfSp,
+        PlannerKind::PfSpEq10,
         PlannerKind::PfIso,
         PlannerKind::PfIsoPred,
     ];
 
-    /// The kebab-case name (`pf-cs`, `pf-sp`, `pf-iso`, `pf-iso-pred`).
+    /// The kebab-case name (`pf-cs`, `pf-sp`, `pf-sp-eq10`, `pf-iso`, `pf-iso-pred`).
     pub fn name(&self) -> &'static str {
         match self {
             PlannerKind::PfCs => "pf-cs",
             PlannerKind::PfSp => "pf-sp",
+            PlannerKind::PfSpEq10 => "pf-sp-eq10",
             PlannerKind::PfIso => "pf-iso",
             PlannerKind::PfIsoPred => "pf-iso-pred",
         }
+    }
+
+    /// Whether it uses the interaction term of Eq. 10 (and so the `interaction_*` parameters).
+    pub fn is_interactive(&self) -> bool {
+        matches!(self, PlannerKind::PfIso | PlannerKind::PfIsoPred)
     }
 }
 
@@ -340,51 +349,66 @@ impl PfPlanner {
         }
     }
 
-    /// The others' motion for the interaction term, by id: (trajectory, speed, shape).
-    fn others(
+    /// The non-convex speed term of `kind` and its weight (None for PF-SP-EQ10, or with nobody
+    /// around).
+    /// Also returns the number of other vehicles it considers.
+    fn speed_term(
         &self,
+        kind: PlannerKind,
         req: &PlanRequest<'_>,
-    ) -> BTreeMap<VehicleId, (Trajectory, f64, VehicleShape)> {
-        let mut others = BTreeMap::new();
-        if self.kind == PlannerKind::PfIso {
-            // The newest fresh SLP of each sender.
-            let mut newest: BTreeMap<VehicleId, &SharedLocalPath> = BTreeMap::new();
-            for m in req.shared_paths {
-                let age_s = req.time_s - m.stamp_s;
-                if m.vehicle_id == req.ego_id || age_s > self.params.max_shared_path_age_s {
-                    continue;
-                }
-                match newest.get(&m.vehicle_id) {
-                    Some(old) if old.stamp_s >= m.stamp_s => {}
-                    _ => {
-                        newest.insert(m.vehicle_id, m);
-                    }
-                }
-            }
-            for (id, m) in newest {
-                let yaw = req
-                    .neighbours
-                    .iter()
-                    .find(|n| n.id == id)
-                    .map_or(0.0, |n| n.state.yaw_rad);
-                if let Some(trajectory) = Trajectory::from_shared(m, yaw) {
-                    others.insert(id, (trajectory, m.speed_mps, m.shape));
-                }
-            }
+        line: &Polyline,
+        waypoints: &[[f64; 2]],
+    ) -> (Option<Box<dyn SpeedTerm>>, f64, usize) {
+        let params = &self.params;
+        let (use_shared_paths, weight) = match kind {
+            PlannerKind::PfCs | PlannerKind::PfSpEq10 => return (None, 0.0, 0),
+            PlannerKind::PfSp => (false, params.risk_weight),
+            PlannerKind::PfIso => (true, params.interaction_weight),
+            PlannerKind::PfIsoPred => (false, params.interaction_weight),
+        };
+        let others = gather_others(params, &self.road, req, use_shared_paths, params.prediction);
+        let count = others.len();
+        if others.is_empty() || weight <= 0.0 {
+            return (None, weight, count);
         }
-        if matches!(self.kind, PlannerKind::PfIso | PlannerKind::PfIsoPred) {
-            for n in req.neighbours {
-                if n.id == req.ego_id || others.contains_key(&n.id) {
-                    continue;
+        let term: Box<dyn SpeedTerm> = if kind == PlannerKind::PfSp {
+            // Risk along its own path: the path field, roles from the order now.
+            let rules = RoleRules {
+                rear_only: false,
+                from_order_now: params.interaction_roles_from_order_now,
+            };
+            Box::new(arc_length_term(
+                params,
+                &params.path_field(),
+                rules,
+                Aggregate::Linear,
+                req,
+                &others,
+                line,
+            ))
+        } else {
+            let rules = RoleRules {
+                rear_only: params.interaction_rear_only,
+                from_order_now: params.interaction_roles_from_order_now,
+            };
+            match params.interaction_slp_reading {
+                SlpReading::ArcLength => Box::new(arc_length_term(
+                    params,
+                    &params.interaction_field(),
+                    rules,
+                    Aggregate::LogFloored {
+                        floor: params.interaction_floor,
+                    },
+                    req,
+                    &others,
+                    line,
+                )),
+                SlpReading::FixedWaypoints => {
+                    Box::new(fixed_waypoint_term(params, rules, req, &others, waypoints))
                 }
-                let trajectory = Trajectory::ConstantVelocity {
-                    state: n.state,
-                    time_s: req.time_s,
-                };
-                others.insert(n.id, (trajectory, n.state.speed_mps, n.shape));
             }
-        }
-        others
+        };
+        (Some(term), weight, count)
     }
 
     fn plan_cycle(&mut self, req: &PlanRequest<'_>) -> Result<Plan, CycleFailure> {
@@ -439,21 +463,21 @@ impl PfPlanner {
         let line = Polyline::with_start([req.ego.x_m, req.ego.y_m], points.iter().copied());
         let segment_lengths_m = line.segment_lengths_m();
 
-        // Eq. 10: speeds.
+        // Speeds (Eq. 10, or PF-SP's risk-aware problem).
         let speeds_mps = match self.kind {
             PlannerKind::PfCs => vec![
                 req.target_speed_mps
                     .clamp(params.min_speed_mps, params.speed_limit_mps);
                 n
             ],
-            PlannerKind::PfSp | PlannerKind::PfIso | PlannerKind::PfIsoPred => {
+            kind => {
                 let mut max_speeds_mps = friction_speed_limits(
                     |xi| cubic.curvature_per_m(xi),
                     &xis,
                     req.mu,
                     params.speed_limit_mps,
                 );
-                if self.kind != PlannerKind::PfSp && params.interaction_slows_only {
+                if kind.is_interactive() && params.interaction_slows_only {
                     // The interaction may only slow the vehicle: cap at V_target, or at a
                     // comfortable deceleration from the current speed if that is higher.
                     let decel_mps = params.max_accel_mps2 * params.step_time_s;
@@ -462,58 +486,8 @@ impl PfPlanner {
                         *v = v.min(req.target_speed_mps.max(from_now));
                     }
                 }
-                let interaction = if self.kind == PlannerKind::PfSp {
-                    None
-                } else {
-                    let others = self.others(req);
-                    self.stats.interacting_vehicles = others.len();
-                    (!others.is_empty()).then(|| {
-                        let me = SelfView {
-                            speed_mps: req.ego.speed_mps,
-                            shape: req.ego_shape,
-                        };
-                        let bases: Vec<(ObstacleField, &Trajectory)> = others
-                            .values()
-                            .map(|(trajectory, speed, shape)| {
-                                let field =
-                                    ObstacleField::new(params, me, 0.0, 0.0, 0.0, *speed, shape);
-                                let field = if params.interaction_rear_only {
-                                    let half_lengths_m =
-                                        0.5 * (req.ego_shape.length_m + shape.length_m);
-                                    field.rear_only(half_lengths_m, params)
-                                } else {
-                                    field
-                                };
-                                (field, trajectory)
-                            })
-                            .collect();
-                        let fields = (1..=n)
-                            .map(|i| {
-                                let t_s = req.time_s + i as f64 * params.step_time_s;
-                                bases
-                                    .iter()
-                                    .map(|(base, trajectory)| {
-                                        let pose = trajectory.pose_at(t_s);
-                                        base.moved_to(
-                                            pose.xy_m[0],
-                                            pose.xy_m[1],
-                                            pose.heading[0],
-                                            pose.heading[1],
-                                        )
-                                    })
-                                    .collect()
-                            })
-                            .collect();
-                        let (sin_yaw, cos_yaw) = req.ego.yaw_rad.sin_cos();
-                        InteractionTerm::new(
-                            line.clone(),
-                            [cos_yaw, sin_yaw],
-                            params.step_time_s,
-                            params.interaction_floor,
-                            fields,
-                        )
-                    })
-                };
+                let (term, weight, count) = self.speed_term(kind, req, &line, &waypoints);
+                self.stats.interacting_vehicles = count;
                 // Warm start: the last good plan's speeds at the same absolute times.
                 let guess: Option<Vec<f64>> = self.last_good.as_ref().and_then(|last| {
                     (1..=n)
@@ -531,7 +505,8 @@ impl PfPlanner {
                     segment_lengths_m: &segment_lengths_m,
                     max_speeds_mps: &max_speeds_mps,
                     initial_guess_mps: guess.as_deref(),
-                    interaction: interaction.as_ref(),
+                    interaction: term.as_deref(),
+                    interaction_weight: weight,
                 };
                 let solution = self
                     .optimiser

@@ -96,11 +96,12 @@ impl<'a> PotentialField<'a> {
                 [n.state.speed_mps * c, n.state.speed_mps * s]
             })
             .collect();
+        let field_params = params.path_field();
         let obstacles = others
             .iter()
             .map(|n| {
                 ObstacleField::new(
-                    params,
+                    &field_params,
                     me,
                     n.state.x_m,
                     n.state.y_m,

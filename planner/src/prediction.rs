@@ -1,8 +1,39 @@
 //! Where the other vehicles will be: their shared local path (SLP) interpolated in time, or a
-//! constant-velocity prediction from their perceived state (PF-ISO-PRED, and PF-ISO for a
-//! vehicle whose SLP is missing or stale).
+//! prediction from their perceived state (PF-ISO-PRED, PF-SP, and PF-ISO for a vehicle whose
+//! SLP is missing or stale): straight along the heading at constant velocity, or following the
+//! road ([`PredictionModel`]).
 
+use serde::{Deserialize, Serialize};
+
+use crate::road::MergeRoad;
 use crate::types::{SharedLocalPath, TimedWaypoint, VehicleState};
+
+/// How a vehicle without a fresh shared path is predicted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PredictionModel {
+    /// Straight along its current heading at its current speed. A car 0.02 rad off the road
+    /// axis is predicted 3.2 m — a lane — off its lane after 160 m.
+    ConstantVelocity,
+    /// Along the road at its current speed, keeping its lateral position; in the ending lane
+    /// it is lifted to stay half a lane above the tapering edge, so a merging car is predicted
+    /// to merge where the lane ends.
+    LaneFollowing,
+}
+
+impl PredictionModel {
+    /// The prediction of a vehicle in `state` at `time_s`.
+    pub fn trajectory(self, state: VehicleState, time_s: f64, road: &MergeRoad) -> Trajectory {
+        match self {
+            PredictionModel::ConstantVelocity => Trajectory::ConstantVelocity { state, time_s },
+            PredictionModel::LaneFollowing => Trajectory::LaneFollowing {
+                state,
+                time_s,
+                road: road.clone(),
+            },
+        }
+    }
+}
 
 /// A predicted pose: position and unit heading vector (cos ψ, sin ψ).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,6 +62,16 @@ pub enum Trajectory {
         /// Time of the state (s).
         time_s: f64,
     },
+    /// Along the road (+X) at the current speed, lateral position kept, but at least half a
+    /// lane above the lower edge where the ending lane tapers.
+    LaneFollowing {
+        /// State at `time_s`.
+        state: VehicleState,
+        /// Time of the state (s).
+        time_s: f64,
+        /// The road it follows.
+        road: MergeRoad,
+    },
 }
 
 impl Trajectory {
@@ -56,9 +97,58 @@ impl Trajectory {
         })
     }
 
+    /// Whether this is a prediction (not a received shared path).
+    pub fn is_predicted(&self) -> bool {
+        !matches!(self, Self::Shared { .. })
+    }
+
+    /// Speed along the trajectory at absolute time `t_s` (m/s): the state's speed for a
+    /// prediction, the speed of the segment of a shared path.
+    pub fn speed_at(&self, t_s: f64) -> f64 {
+        match self {
+            Self::ConstantVelocity { state, .. } | Self::LaneFollowing { state, .. } => {
+                state.speed_mps
+            }
+            Self::Shared { waypoints, .. } => {
+                let n = waypoints.len();
+                if n < 2 {
+                    return 0.0;
+                }
+                let k = waypoints
+                    .partition_point(|w| w.t_s <= t_s)
+                    .saturating_sub(1)
+                    .min(n - 2);
+                let (a, b) = (waypoints[k], waypoints[k + 1]);
+                (b.x_m - a.x_m).hypot(b.y_m - a.y_m) / (b.t_s - a.t_s)
+            }
+        }
+    }
+
     /// Pose at absolute time `t_s`.
     pub fn pose_at(&self, t_s: f64) -> PredictedPose {
         match self {
+            Self::LaneFollowing {
+                state,
+                time_s,
+                road,
+            } => {
+                let x_m = state.x_m + state.speed_mps * (t_s - time_s);
+                let half_lane_m = 0.5 * road.lane_width_m;
+                let lifted_y_m = road.lower_edge_y_m(x_m) + half_lane_m;
+                if state.y_m < road.y_lane_m() && lifted_y_m > state.y_m {
+                    let slope = road.lower_edge_slope(x_m);
+                    let norm = slope.hypot(1.0);
+                    PredictedPose {
+                        xy_m: [x_m, lifted_y_m],
+                        heading: [1.0 / norm, slope / norm],
+                    }
+                } else {
+                    PredictedPose {
+                        xy_m: [x_m, state.y_m],
+                        heading: [1.0, 0.0],
+                    }
+                }
+            }
             Self::ConstantVelocity { state, time_s } => {
                 let (s, c) = state.yaw_rad.sin_cos();
                 let d = state.speed_mps * (t_s - time_s);
@@ -143,6 +233,74 @@ mod tests {
         assert_eq!(mid.heading, [1.0, 0.0]);
         let late = trajectory.pose_at(13.0);
         assert!((late.xy_m[0] - 30.0).abs() < 1e-12 && (late.xy_m[1] - 10.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn lane_following_keeps_the_lane_and_merges_with_the_taper() {
+        let road = MergeRoad::default();
+        // An upper-lane car slightly yawed: stays at its lateral position along the road.
+        let upper = VehicleState {
+            x_m: 0.0,
+            y_m: 5.3,
+            yaw_rad: 0.03,
+            speed_mps: 15.0,
+        };
+        let t = PredictionModel::LaneFollowing.trajectory(upper, 2.0, &road);
+        let pose = t.pose_at(10.0);
+        assert_eq!(pose.xy_m, [120.0, 5.3]);
+        assert_eq!(pose.heading, [1.0, 0.0]);
+        assert!(t.is_predicted());
+        assert_eq!(t.speed_at(5.0), 15.0);
+        // A lower-lane car: on its lane centre before the taper, lifted by the tapering edge,
+        // on the through lane's centre after the merge section.
+        let lower = VehicleState {
+            x_m: 100.0,
+            y_m: road.lane_center_y_m(crate::road::Lane::Lower),
+            yaw_rad: 0.0,
+            speed_mps: 20.0,
+        };
+        let t = PredictionModel::LaneFollowing.trajectory(lower, 0.0, &road);
+        assert_eq!(t.pose_at(2.0).xy_m[1], lower.y_m);
+        let mid_x = 0.5 * (road.merge_start_x_m + road.merge_end_x_m);
+        let mid = t.pose_at((mid_x - 100.0) / 20.0);
+        let expected = road.lower_edge_y_m(mid_x) + 0.5 * road.lane_width_m;
+        assert!((mid.xy_m[1] - expected).abs() < 1e-9 && mid.xy_m[1] > lower.y_m);
+        assert!(mid.heading[1] > 0.0, "heading along the taper");
+        let after = t.pose_at((road.merge_end_x_m + 20.0 - 100.0) / 20.0);
+        let upper_centre = road.lane_center_y_m(crate::road::Lane::Upper);
+        assert!((after.xy_m[1] - upper_centre).abs() < 1e-9);
+    }
+
+    #[test]
+    fn shared_path_speed_is_the_segment_speed() {
+        let message = SharedLocalPath {
+            vehicle_id: 1,
+            stamp_s: 0.0,
+            shape: VehicleShape::default(),
+            speed_mps: 10.0,
+            waypoints: vec![
+                TimedWaypoint {
+                    t_s: 0.0,
+                    x_m: 0.0,
+                    y_m: 0.0,
+                },
+                TimedWaypoint {
+                    t_s: 1.0,
+                    x_m: 3.0,
+                    y_m: 4.0,
+                },
+                TimedWaypoint {
+                    t_s: 3.0,
+                    x_m: 13.0,
+                    y_m: 4.0,
+                },
+            ],
+        };
+        let t = Trajectory::from_shared(&message, 0.0).unwrap();
+        assert_eq!(t.speed_at(0.5), 5.0);
+        assert_eq!(t.speed_at(2.0), 5.0);
+        assert_eq!(t.speed_at(9.0), 5.0);
+        assert!(!t.is_predicted());
     }
 
     #[test]

@@ -1,0 +1,142 @@
+//! Interactive speed optimisation, paper Eq. 10, solved by sequential convex programming
+//! (SCP) with Clarabel.
+//!
+//! Files: [`scp`] (the SCP loop and its line search), [`cone_program`] (the convex
+//! subproblem: decision vector, constraint rows and their assembly), [`interaction_term`]
+//! (U_SLP at the planned arc length, and PF-SP's risk term), [`fixed_waypoint_term`] (U_SLP as
+//! the paper prints it), [`friction_limits`] (Eq. 10a).
+//!
+//! # The problem (Eq. 10, as read here)
+//!
+//! Over the speeds v = (v_1 … v_N):
+//!
+//! ```text
+//!   minimise   J(v) = w1 Σ_i Δs_i / v_i                    travel time along the path
+//!                   + w2 Σ_i ½ (v_i − V_target)²            deviation from the target speed
+//!                   + w3 Σ_i φ_i(v)                         interaction with the others' SLPs
+//!   subject to v_min ≤ v_i ≤ V_i^max = min(V_limit, √(μ g / |κ_i|))          (Eq. 10a)
+//!              |v_{i+1} − v_i| ≤ a_max Δt,  |v_1 − v_0| ≤ a_max Δt            (optional)
+//!              |v_{i+1} − 2 v_i + v_{i−1}| ≤ j_max Δt²                        (optional)
+//!
+//!   φ_i(v) = ln(ε_I + Σ_o U_OB^o(e_i(v); q_o(t_0 + iΔt))) − ln ε_I
+//!   e_i(v) = path(s_i),   s_i = Δt Σ_{j ≤ i} v_j
+//! ```
+//!
+//! Δs_i is the length of the i-th segment of the fitted path; e_i is where the ego is after i
+//! time steps of Δt = Δt_plan (the brief's s_i = Σ v_j Δt), q_o(t) the other vehicle's SLP
+//! interpolated at the same absolute time (time-matched, so a stale or differently sampled
+//! SLP pairs correctly); U_OB is Eq. 4 centred on q_o with its heading.
+//!
+//! Readings (also in `planner/README.md`): the paper's `ln U_SLP` of a single Gaussian is
+//! ln A − q, a concave quadratic whose pull grows without bound with the separation, so far
+//! vehicles would dominate the speed choice; we read U_SLP as the accumulated field
+//! ε_I + Σ_o U_OB^o with a floor ε_I (`interaction_floor`): ln U ≈ ln A − q near a vehicle,
+//! and the term fades (to 0 after subtracting the constant ln ε_I) once the others' fields
+//! fall below ε_I. v_min > 0 keeps Δs/v finite (the paper writes 0 ≤ v_i).
+//!
+//! # Solution
+//!
+//! The travel time is convex: t_i ≥ Δs_i / v_i ⇔ t_i v_i ≥ Δs_i, t_i, v_i ≥ 0
+//! ⇔ ‖(t_i − v_i, 2√Δs_i)‖ ≤ t_i + v_i, a second-order cone. The interaction term is
+//! linearised at the current iterate v̄ (φ ≈ φ(v̄) + ∇φ(v̄)ᵀ(v − v̄)), the resulting convex
+//! cone program is solved inside the trust region |v_i − v̄_i| ≤ ρ, and the step d = v* − v̄
+//! to its solution v* is shortened by a backtracking line search on the true J (t = 1, ½, ¼, …
+//! until J(v̄ + t d) ≤ J(v̄) + ¼ t ∇J(v̄)ᵀd, see `ARMIJO_FRACTION`; ρ is halved when t < 1
+//! or no t passes); iterations stop when J stops falling or after `max_scp_iterations` solves. The linearised
+//! interaction has no curvature, so v* usually sits on the trust-region boundary; kept whole
+//! (or rejected, the only alternative), the step could only move by ρ, ρ/2, …, and when the
+//! minimum lies between v̄ and v̄ ± ρ/2 successive planning cycles (each one warm-started at
+//! the last) jumped across it and back: a cycle-to-cycle sawtooth of ±ρ/4 in the planned
+//! speed. d is a descent direction whenever the convex model falls (the model's convex
+//! part is exact and its linear part is the gradient), so the search always finds a decrease
+//! unless v̄ is stationary, and v̄ + t d stays feasible (convex feasible set). It costs
+//! evaluations of J only, no extra solves. The start v̄⁰ is `initial_guess` (the previous plan
+//! shifted in time: across planning cycles this continues the same SCP, as in real-time
+//! iteration schemes) projected onto the box and acceleration chain, so every accepted
+//! iterate is feasible and J never exceeds J(v̄⁰). With jerk rows the projection may be
+//! infeasible and the first iteration runs without a trust region. With w3 = 0 (PF-SP) the
+//! problem is convex and one solve is exact. All iterations, and consecutive planning
+//! cycles, reuse one Clarabel solver through `update_q` / `update_b` (P and A are fixed).
+//!
+//! The non-convex term is any [`SpeedTerm`]: w3·Σ φ_i of PF-ISO (either reading of U_SLP), or
+//! w_R·Σ U_i of PF-SP's risk-aware speeds, with its own weight in [`SpeedProblem`].
+
+pub mod cone_program;
+pub mod fixed_waypoint_term;
+pub mod friction_limits;
+pub mod interaction_term;
+pub mod scp;
+
+pub use fixed_waypoint_term::FixedWaypointTerm;
+pub use friction_limits::friction_speed_limits;
+pub use interaction_term::{Aggregate, InteractionTerm};
+pub use scp::SpeedOptimiser;
+
+use crate::params::PlannerParams;
+
+/// A smooth, possibly non-convex term Σ_i φ_i(v) of the speed objective, linearised by the SCP.
+pub trait SpeedTerm: std::fmt::Debug {
+    /// Number of time slots (one per speed).
+    fn slots(&self) -> usize;
+
+    /// Σ_i φ_i(v) and its gradient with respect to v.
+    fn value_and_gradient(&self, speeds_mps: &[f64]) -> (f64, Vec<f64>);
+
+    /// Σ_i φ_i(v).
+    fn value(&self, speeds_mps: &[f64]) -> f64 {
+        self.value_and_gradient(speeds_mps).0
+    }
+}
+
+/// One speed problem (module doc).
+#[derive(Clone, Copy, Debug)]
+pub struct SpeedProblem<'a> {
+    /// v_0, the current speed (m/s): anchors v_1 when the acceleration bound is on.
+    pub current_speed_mps: f64,
+    /// V_target (m/s).
+    pub target_speed_mps: f64,
+    /// Δs_i, i = 1..N (m).
+    pub segment_lengths_m: &'a [f64],
+    /// V_i^max (m/s), already min(V_limit, friction limit).
+    pub max_speeds_mps: &'a [f64],
+    /// Where iteration 0 linearises the non-convex term (default: V_target clipped).
+    pub initial_guess_mps: Option<&'a [f64]>,
+    /// The non-convex term (None: the convex Eq. 10 with w3 = 0).
+    pub interaction: Option<&'a dyn SpeedTerm>,
+    /// Its weight (w3 for U_SLP, w_R for PF-SP's risk); 0 drops it.
+    pub interaction_weight: f64,
+}
+
+/// The optimiser's answer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpeedSolution {
+    /// v_1..v_N (m/s).
+    pub speeds_mps: Vec<f64>,
+    /// J(v) (true objective, not the linearised one).
+    pub objective: f64,
+    /// Convex solves performed.
+    pub solves: usize,
+    /// Whether v_1 was anchored to the current speed.
+    pub anchored: bool,
+}
+
+/// J(v) of Eq. 10 (module doc), with the non-convex term if given.
+pub fn objective(params: &PlannerParams, problem: &SpeedProblem<'_>, speeds_mps: &[f64]) -> f64 {
+    let mut j = 0.0;
+    for (v, ds) in speeds_mps.iter().zip(problem.segment_lengths_m) {
+        let dv = v - problem.target_speed_mps;
+        j += params.travel_time_weight * ds / v + 0.5 * params.speed_deviation_weight * dv * dv;
+    }
+    if let Some(term) = problem.interaction
+        && problem.interaction_weight > 0.0
+    {
+        j += problem.interaction_weight * term.value(speeds_mps);
+    }
+    j
+}
+
+/// ∂/∂v_i of the convex part of J (travel time and target speed): −w1 Δs_i / v_i² + w2 (v_i − V).
+fn smooth_gradient(params: &PlannerParams, problem: &SpeedProblem<'_>, i: usize, v: f64) -> f64 {
+    -params.travel_time_weight * problem.segment_lengths_m[i] / (v * v)
+        + params.speed_deviation_weight * (v - problem.target_speed_mps)
+}
