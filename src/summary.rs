@@ -10,6 +10,8 @@ pub struct RunSummary {
     pub scenario: String,
     /// Planner name (`pf-iso`, ..., or `mixed`).
     pub planner: String,
+    /// Planner parameter set (`paper` or `mergesim`).
+    pub params: String,
     /// Seed of the run (null for the nominal scenario).
     pub seed: Option<u64>,
     /// Simulated time (s).
@@ -38,6 +40,7 @@ impl RunSummary {
     /// Builds the summary of a finished run.
     pub fn new(
         scenario: &str,
+        params: planner::ParameterSet,
         planner: &str,
         seed: Option<u64>,
         wall_time_s: f64,
@@ -45,6 +48,7 @@ impl RunSummary {
     ) -> Self {
         Self {
             scenario: scenario.to_string(),
+            params: params.name().to_string(),
             planner: planner.to_string(),
             seed,
             duration_s: outcome.duration_s,
@@ -68,8 +72,8 @@ impl RunSummary {
             .map(|t| format!("{t:.2} s"))
             .unwrap_or_else(|| "never closing".into());
         out.push_str(&format!(
-            "scenario {}  planner {}  simulated {:.1} s in {:.2} s wall\n",
-            self.scenario, self.planner, self.duration_s, self.wall_time_s
+            "scenario {}  planner {} ({} parameters)  simulated {:.1} s in {:.2} s wall\n",
+            self.scenario, self.planner, self.params, self.duration_s, self.wall_time_s
         ));
         out.push_str(&format!(
             "collisions {}  min gap {}  min TTC {}  near miss {}  TET {:.2} s\n",

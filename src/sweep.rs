@@ -184,6 +184,8 @@ pub struct SweepSummary {
     pub scenario_fingerprint: String,
     /// Planner name (`pf-iso`, ..., or `mixed`).
     pub planner: String,
+    /// Planner parameter set (`paper` or `mergesim`).
+    pub params: String,
     /// Sweep seed K.
     pub seed: u64,
     /// Instances in the whole sweep.
@@ -242,6 +244,8 @@ pub struct SweepIdentity {
     pub scenario: String,
     /// See [`SweepSummary::scenario_fingerprint`].
     pub scenario_fingerprint: String,
+    /// Planner parameter set.
+    pub params: String,
     /// Planner name.
     pub planner: String,
     /// Sweep seed.
@@ -257,6 +261,7 @@ impl SweepIdentity {
         SweepIdentity {
             scenario: plan.scenario.name.clone(),
             scenario_fingerprint: format!("{:016x}", fnv1a64(&canonical)),
+            params: plan.scenario.params.name().to_string(),
             planner: planner_label(&plan.scenario, plan.planner),
             seed: plan.seed,
             total_runs: plan.runs,
@@ -293,6 +298,7 @@ impl SweepSummary {
         SweepSummary {
             scenario: identity.scenario.clone(),
             scenario_fingerprint: identity.scenario_fingerprint.clone(),
+            params: identity.params.clone(),
             planner: identity.planner.clone(),
             seed: identity.seed,
             total_runs: identity.total_runs,
@@ -326,6 +332,7 @@ impl SweepSummary {
         SweepIdentity {
             scenario: self.scenario.clone(),
             scenario_fingerprint: self.scenario_fingerprint.clone(),
+            params: self.params.clone(),
             planner: self.planner.clone(),
             seed: self.seed,
             total_runs: self.total_runs,
@@ -419,7 +426,7 @@ pub fn planner_label(scenario: &Scenario, planner: Option<PlannerKind>) -> Strin
     let mut kinds: Vec<&str> = scenario
         .vehicles
         .iter()
-        .filter_map(|v| match v.driver {
+        .filter_map(|v| match &v.driver {
             sim::Driver::Planner(kind) => Some(kind.name()),
             // Lane keeping (and any other non-planner driver, e.g. a future IDM).
             _ => None,
@@ -453,6 +460,7 @@ pub fn simulate_instance(plan: &SweepPlan, seed: u64) -> Result<RunSummary, sim:
     let label = planner_label(&plan.scenario, plan.planner);
     Ok(RunSummary::new(
         &plan.scenario.name,
+        plan.scenario.params,
         &label,
         Some(seed),
         started.elapsed().as_secs_f64(),
@@ -584,6 +592,7 @@ pub fn merge_shards(parts: Vec<(String, SweepSummary)>) -> Result<SweepSummary, 
                 other.scenario_fingerprint.clone(),
             ),
             ("planner", identity.planner.clone(), other.planner.clone()),
+            ("params", identity.params.clone(), other.params.clone()),
             ("seed", identity.seed.to_string(), other.seed.to_string()),
             (
                 "total_runs",

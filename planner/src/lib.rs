@@ -21,6 +21,7 @@ pub mod prediction;
 pub mod road;
 pub mod road_field;
 pub mod speed_optimisation;
+pub mod speed_profile;
 pub mod types;
 
 pub use error::PlannerError;
@@ -29,4 +30,5 @@ pub use params::{PlannerParams, SlpReading};
 pub use planners::{PfPlanner, PlanRequest, PlanStats, PlannerKind};
 pub use potential_field::{GridSpec, PotentialField};
 pub use road::{Lane, MergeRoad};
+pub use speed_profile::SpeedProfile;
 pub use types::*;

@@ -87,7 +87,9 @@ pub struct PathPoint {
     pub x_m: f64,
     /// Position (m).
     pub y_m: f64,
-    /// Speed to hold from here to the next point (m/s).
+    /// Planned speed on the segment from this point to the next (m/s): the times follow
+    /// t_{k+1} = t_k + Δs_k / v_k. The tracker aims at the speed of the point ahead of the
+    /// vehicle, i.e. the next segment's, which previews the profile by one segment.
     pub speed_mps: f64,
     /// Planned absolute arrival time (s).
     pub t_s: f64,

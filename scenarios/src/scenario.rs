@@ -3,7 +3,7 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use planner::Lane;
+use planner::{Lane, ParameterSet, PlannerParams};
 use serde::{Deserialize, Serialize};
 use sim::{SimConfig, SimError, VehicleSpec};
 use thiserror::Error;
@@ -21,7 +21,13 @@ pub struct Scenario {
     /// One line saying what it is.
     #[serde(default)]
     pub description: String,
+    /// The planner parameter set (`paper` or `mergesim`, the default) that `[sim.planner]`
+    /// values are applied on top of.
+    #[serde(default)]
+    pub params: ParameterSet,
     /// Shared settings: road, μ, time steps, V2V, planner, tracker, safety thresholds.
+    /// `sim.planner` holds the effective planner parameters: the set's, with the file's
+    /// `[sim.planner]` values on top.
     #[serde(default)]
     pub sim: SimConfig,
     /// The vehicles, in id order.
@@ -29,6 +35,23 @@ pub struct Scenario {
     /// Randomisation ranges for sweeps and `run --seed` (empty: every instance is nominal).
     #[serde(default, skip_serializing_if = "Randomisation::is_empty")]
     pub randomise: Randomisation,
+    /// The `[sim.planner]` values the file sets (applied on top of `params`).
+    #[serde(skip)]
+    pub planner_overrides: toml::Table,
+}
+
+/// The planner parameters of `set` with `overrides` (a `[sim.planner]` table) on top.
+pub fn planner_params_with_overrides(
+    set: ParameterSet,
+    overrides: &toml::Table,
+) -> Result<PlannerParams, String> {
+    let mut table = toml::Table::try_from(set.planner_params()).map_err(|e| e.to_string())?;
+    for (key, value) in overrides {
+        table.insert(key.clone(), value.clone());
+    }
+    toml::Value::Table(table)
+        .try_into()
+        .map_err(|e: toml::de::Error| e.to_string())
 }
 
 /// A line of a scenario text, shown as `, line N` after the file name (nothing if unknown).
@@ -107,12 +130,45 @@ impl Scenario {
 
     /// Parses and validates a scenario from TOML text; `origin` names it in errors.
     pub fn from_toml(text: &str, origin: &str) -> Result<Self, ScenarioError> {
-        let scenario: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
+        let parse_error = |e: toml::de::Error| ScenarioError::Parse {
             origin: origin.to_string(),
             message: e.to_string().trim_end().to_string(),
-        })?;
+        };
+        let mut scenario: Scenario = toml::from_str(text).map_err(parse_error)?;
+        // The [sim.planner] values as written, to apply on top of the parameter set.
+        let table: toml::Table = toml::from_str(text).map_err(parse_error)?;
+        scenario.planner_overrides = table
+            .get("sim")
+            .and_then(|sim| sim.get("planner"))
+            .and_then(|planner| planner.as_table())
+            .cloned()
+            .unwrap_or_default();
+        scenario.apply_parameter_set(origin, Some(text))?;
         scenario.check(origin, Some(text))?;
         Ok(scenario)
+    }
+
+    /// The same scenario with the planner parameter set `set` (its `[sim.planner]` values kept
+    /// on top), checked again.
+    pub fn with_parameter_set(&self, set: ParameterSet) -> Result<Self, ScenarioError> {
+        let mut scenario = self.clone();
+        scenario.params = set;
+        let origin = format!("{} with --params {set}", self.name);
+        scenario.apply_parameter_set(&origin, None)?;
+        scenario.check(&origin, None)?;
+        Ok(scenario)
+    }
+
+    /// `sim.planner` = the set's parameters with the overrides on top.
+    fn apply_parameter_set(&mut self, origin: &str, text: Option<&str>) -> Result<(), ScenarioError> {
+        self.sim.planner = planner_params_with_overrides(self.params, &self.planner_overrides)
+            .map_err(|message| ScenarioError::Invalid {
+                origin: origin.to_string(),
+                line: Line(text.and_then(|t| line_of(t, &["sim".to_string(), "planner".to_string()]))),
+                field: Some("sim.planner".into()),
+                message: format!("[sim.planner] on top of the {} set: {message}", self.params),
+            })?;
+        Ok(())
     }
 
     /// Checks every value, nominal and randomised (see [`Scenario::check`]).
@@ -257,12 +313,32 @@ impl Scenario {
         Some(path)
     }
 
-    /// The scenario as TOML text.
+    /// The scenario as TOML text. `[sim.planner]` holds only the values that differ from the
+    /// parameter set's, so the text reads back to the same effective parameters.
     pub fn to_toml(&self) -> Result<String, ScenarioError> {
-        toml::to_string(self).map_err(|e| ScenarioError::Parse {
+        let error = |message: String| ScenarioError::Parse {
             origin: self.name.clone(),
-            message: e.to_string(),
-        })
+            message,
+        };
+        let mut table = toml::Table::try_from(self).map_err(|e| error(e.to_string()))?;
+        let base = toml::Table::try_from(self.params.planner_params())
+            .map_err(|e| error(e.to_string()))?;
+        if let Some(sim) = table.get_mut("sim").and_then(|v| v.as_table_mut()) {
+            let differing: toml::Table = match sim.get("planner").and_then(|p| p.as_table()) {
+                Some(planner) => planner
+                    .iter()
+                    .filter(|(key, value)| base.get(*key) != Some(*value))
+                    .map(|(key, value)| (key.clone(), value.clone()))
+                    .collect(),
+                None => toml::Table::new(),
+            };
+            if differing.is_empty() {
+                sim.remove("planner");
+            } else {
+                sim.insert("planner".into(), toml::Value::Table(differing));
+            }
+        }
+        toml::to_string(&table).map_err(|e| error(e.to_string()))
     }
 
     /// The instance drawn with `seed` from the `[randomise]` ranges (DESIGN: "same scenario +
@@ -274,9 +350,11 @@ impl Scenario {
         Scenario {
             name: self.name.clone(),
             description: self.description.clone(),
+            params: self.params,
             sim,
             vehicles,
             randomise: Randomisation::default(),
+            planner_overrides: self.planner_overrides.clone(),
         }
     }
 

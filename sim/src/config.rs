@@ -1,6 +1,6 @@
 //! What a simulation is made of: the shared settings and the vehicles to spawn.
 
-use planner::{Lane, MergeRoad, PlannerKind, PlannerParams};
+use planner::{Lane, MergeRoad, PlannerKind, PlannerParams, SpeedProfile};
 use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
 
@@ -109,11 +109,21 @@ impl SimConfig {
 }
 
 /// How a vehicle decides its path and speed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Driver {
     /// A potential-field planner of the given kind.
     Planner(PlannerKind),
+    /// The path of a potential-field planner (`path_planner`), the speeds of a prescribed
+    /// time → speed profile (`speed_profile = [[t_s, speed_mps], …]`, linear in between, held
+    /// outside). Not changed by `--planner`. Tests whether a given speed profile (e.g. the
+    /// paper's pre-braking) changes the winding, without the speed optimiser.
+    Prescribed {
+        /// Planner whose path the vehicle follows.
+        path_planner: PlannerKind,
+        /// The speeds.
+        speed_profile: SpeedProfile,
+    },
     /// No planner: holds its lane centre and target speed, blind to others (for deliberately
     /// unsafe tests).
     LaneKeeping,
@@ -172,6 +182,22 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
         }
         vehicles::VehicleParams::preset(&spec.preset)?;
         let field = |name: &str| format!("vehicles[{}].{name}", spec.name);
+        if let Driver::Prescribed { speed_profile, .. } = &spec.driver {
+            speed_profile
+                .validate(&field("driver.prescribed"))
+                .map_err(|e| match e {
+                    planner::PlannerError::InvalidParameter {
+                        name,
+                        value,
+                        reason,
+                    } => SimError::InvalidParameter {
+                        name,
+                        value,
+                        reason,
+                    },
+                    other => SimError::InvalidScenario(other.to_string()),
+                })?;
+        }
         let ranges = [
             ("x_m", spec.x_m, config.road.start_x_m, config.road.end_x_m),
             ("y_offset_m", spec.y_offset_m, -1.0, 1.0),

@@ -5,6 +5,7 @@ pub mod config;
 pub mod error;
 pub mod idm;
 pub mod metrics;
+pub mod paper_metrics;
 pub mod recording;
 pub mod rng;
 pub mod safety;

@@ -16,6 +16,8 @@
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crate::paper_metrics::{PaperMetrics, PaperMetricsSummary};
+
 /// Thresholds and windows of the metrics.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -192,6 +194,10 @@ pub struct VehicleMetricsSummary {
     pub rms_jerk_lat_mps3: f64,
     /// Whether the vehicle was involved in a collision (set by the caller).
     pub collided: bool,
+    /// The paper's figures (slowing onset, winding in the merge zone, lane offset, divider
+    /// crossing); null when the metrics were made without a road.
+    #[serde(default)]
+    pub paper_metrics: Option<PaperMetricsSummary>,
 }
 
 /// Hysteresis counter of sign changes of a signal beyond a threshold.
@@ -293,6 +299,7 @@ pub struct VehicleMetrics {
     accel_long: SignalStats,
     accel_lat: SignalStats,
     collided: bool,
+    paper: Option<PaperMetrics>,
 }
 
 impl VehicleMetrics {
@@ -330,7 +337,15 @@ impl VehicleMetrics {
             accel_long: SignalStats::default(),
             accel_lat: SignalStats::default(),
             collided: false,
+            paper: None,
         }
+    }
+
+    /// The same metrics also computing the paper's figures on `road` against
+    /// `target_speed_mps` ([`crate::paper_metrics`]).
+    pub fn with_paper_metrics(mut self, road: &planner::MergeRoad, target_speed_mps: f64) -> Self {
+        self.paper = Some(PaperMetrics::new(road, target_speed_mps));
+        self
     }
 
     /// The vehicle name.
@@ -408,6 +423,9 @@ impl VehicleMetrics {
                     .push(p.accel_lat_mps2, s.accel_lat_mps2, dt_s);
             }
         }
+        if let Some(paper) = &mut self.paper {
+            paper.push(s);
+        }
         self.last = Some(*s);
         self.samples += 1;
         Ok(())
@@ -468,6 +486,7 @@ impl VehicleMetrics {
             peak_abs_jerk_lat_mps3: self.accel_lat.rate_peak_abs,
             rms_jerk_lat_mps3,
             collided: self.collided,
+            paper_metrics: self.paper.as_ref().map(PaperMetrics::summary),
         }
     }
 }

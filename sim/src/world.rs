@@ -245,9 +245,16 @@ impl World {
         let y_m = config.road.lane_center_y_m(spec.lane) + spec.y_offset_m;
         let vehicle = Vehicle::spawn(physics, &params, spec.x_m, y_m, 0.0, spec.speed_mps)?;
         let shape = vehicle.shape(VehicleShape::default().max_brake_decel_mps2);
-        let planner = match spec.driver {
+        let planner = match &spec.driver {
+            Driver::Prescribed { path_planner, .. } => Some(
+                PfPlanner::new(*path_planner, config.planner.clone(), config.road.clone())
+                    .map_err(|source| SimError::Planner {
+                        vehicle: spec.name.clone(),
+                        source,
+                    })?,
+            ),
             Driver::Planner(kind) => {
-                let kind = options.planner_override.unwrap_or(kind);
+                let kind = options.planner_override.unwrap_or(*kind);
                 Some(
                     PfPlanner::new(kind, config.planner.clone(), config.road.clone()).map_err(
                         |source| SimError::Planner {
@@ -269,7 +276,8 @@ impl World {
             tracker,
             path: Vec::new(),
             last_plan: None,
-            metrics: VehicleMetrics::new(spec.name.clone()),
+            metrics: VehicleMetrics::new(spec.name.clone())
+                .with_paper_metrics(&config.road, spec.target_speed_mps),
             merged: spec.lane == planner::Lane::Upper,
         })
     }
@@ -524,6 +532,12 @@ impl World {
             if self.step_index.is_multiple_of(self.steps_per_field) && self.recorder.is_enabled() {
                 log_field(&mut self.recorder, planner, &request, &agent.spec.name)?;
             }
+            let plan = match &agent.spec.driver {
+                Driver::Prescribed { speed_profile, .. } if plan.fallback.is_none() => {
+                    plan.with_speed_profile(speed_profile)
+                }
+                _ => plan,
+            };
             agent.path = plan.path.clone();
             if agent.spec.connected {
                 broadcasts.push(plan.shared.clone());

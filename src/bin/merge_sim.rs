@@ -13,7 +13,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use mergesim::output::{check_output_path, write_atomically};
 use mergesim::summary::RunSummary;
 use mergesim::sweep::planner_label;
-use planner::PlannerKind;
+use planner::{ParameterSet, PlannerKind};
 use scenarios::Scenario;
 use sim::recording::Recorder;
 use sim::{RunOptions, RunOutcome, TimeSeriesRow, World};
@@ -81,6 +81,11 @@ struct RunArgs {
     /// Planner of every planner-driven vehicle (overrides the scenario's choice).
     #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
     planner: Option<PlannerKind>,
+    /// Planner parameter set: `paper` (the paper's literal reading) or `mergesim` (our
+    /// improvements) [default: the scenario's `params`, else mergesim]. The scenario's
+    /// [sim.planner] values apply on top of it.
+    #[arg(long, value_name = "SET", value_parser = parse_params)]
+    params: Option<ParameterSet>,
     /// Run the scenario instance drawn with seed N from its [randomise] ranges (N also seeds
     /// the V2V drops); a sweep's per-run rows give each run's seed. Without it the nominal
     /// scenario runs.
@@ -115,6 +120,12 @@ struct CompareArgs {
     #[arg(long, value_delimiter = ',', value_parser = parse_planner,
           default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
     planners: Vec<PlannerKind>,
+    /// Planner parameter set: `paper` (the paper's literal reading) or `mergesim` (our
+    /// improvements) [default: the scenario's `params`, else mergesim]. The scenario's
+    /// [sim.planner] values apply on top of it.
+    #[arg(long, value_name = "SET", value_parser = parse_params)]
+    params: Option<ParameterSet>,
+
     /// Compare on the scenario instance drawn with seed N (as `run --seed N`); without it the
     /// nominal scenario.
     #[arg(long, value_name = "N")]
@@ -176,6 +187,19 @@ enum ScenarioCommand {
 
 fn parse_planner(text: &str) -> Result<PlannerKind, String> {
     text.parse::<PlannerKind>().map_err(|e| e.to_string())
+}
+
+fn parse_params(text: &str) -> Result<ParameterSet, String> {
+    text.parse::<ParameterSet>().map_err(|e| e.to_string())
+}
+
+/// Loads a scenario and switches it to `params` if given.
+fn load_scenario(name_or_path: &str, params: Option<ParameterSet>) -> Result<Scenario, Failure> {
+    let scenario = Scenario::load(name_or_path).map_err(input)?;
+    match params {
+        Some(set) => scenario.with_parameter_set(set).map_err(input),
+        None => Ok(scenario),
+    }
 }
 
 /// An error with its exit code: 2 for bad input, 1 for failures while running.
@@ -265,12 +289,19 @@ fn simulate(
     let progress = progress_printer(show_progress, format!("{} {label}", scenario.name));
     let outcome = world.run(progress).map_err(run_failure)?;
     let wall_time_s = started.elapsed().as_secs_f64();
-    let summary = RunSummary::new(&scenario.name, &label, seed, wall_time_s, &outcome);
+    let summary = RunSummary::new(
+        &scenario.name,
+        scenario.params,
+        &label,
+        seed,
+        wall_time_s,
+        &outcome,
+    );
     Ok(Finished { summary, outcome })
 }
 
 fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
-    let scenario = Scenario::load(&args.scenario).map_err(input)?;
+    let scenario = load_scenario(&args.scenario, args.params)?;
     let label = planner_label(&scenario, args.planner);
     let rrd = if args.no_rrd {
         None
@@ -344,7 +375,7 @@ fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
 }
 
 fn cmd_compare(args: &CompareArgs) -> Result<(), Failure> {
-    let scenario = Scenario::load(&args.scenario).map_err(input)?;
+    let scenario = load_scenario(&args.scenario, args.params)?;
     if let Some(path) = &args.json {
         check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
     }
@@ -523,6 +554,11 @@ struct SweepArgs {
     /// Planner of every planner-driven vehicle (overrides the scenario's choice).
     #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
     planner: Option<PlannerKind>,
+    /// Planner parameter set: `paper` (the paper's literal reading) or `mergesim` (our
+    /// improvements) [default: the scenario's `params`, else mergesim]. The scenario's
+    /// [sim.planner] values apply on top of it.
+    #[arg(long, value_name = "SET", value_parser = parse_params)]
+    params: Option<ParameterSet>,
     /// Number of randomised instances in the whole sweep (at least 1).
     #[arg(long, value_name = "N", value_parser = parse_runs)]
     runs: u64,
@@ -597,7 +633,7 @@ fn write_output(path: &Path, text: &str) -> Result<(), Failure> {
 
 fn cmd_sweep(args: &SweepArgs) -> Result<(), Failure> {
     use mergesim::sweep::{Shard, SweepOptions, SweepPlan, run_sweep};
-    let scenario = Scenario::load(&args.scenario).map_err(input)?;
+    let scenario = load_scenario(&args.scenario, args.params)?;
     for (path, what) in [
         (args.json.as_deref(), "--json"),
         (args.jsonl.as_deref(), "--jsonl"),
