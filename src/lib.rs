@@ -5,6 +5,8 @@
 //! optimisation), [`vehicles`] (Rapier vehicles and tracker), [`sim`] (the closed loop) and
 //! [`scenarios`] (scenario files).
 
+pub mod grid;
+pub mod grid_plot;
 pub mod output;
 pub mod plots;
 pub mod summary;

@@ -125,7 +125,7 @@ pub fn check_plot_dir(dir: &Path) -> Result<(), String> {
     Ok(())
 }
 
-fn ensure_font() -> Result<(), PlotError> {
+pub(crate) fn ensure_font() -> Result<(), PlotError> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     let ok = *REGISTERED.get_or_init(|| {
         [FontStyle::Normal, FontStyle::Bold]
@@ -229,11 +229,11 @@ pub fn write_comparison(
     Ok(written)
 }
 
-type DrawResult = Result<(), String>;
+pub(crate) type DrawResult = Result<(), String>;
 
 /// Renders into a temporary PNG beside `path` (plotters encodes to a file), then moves the bytes
 /// into place with [`write_atomically`].
-fn render_png(
+pub(crate) fn render_png(
     path: &Path,
     size_px: (u32, u32),
     draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> DrawResult,
@@ -269,7 +269,7 @@ fn render_png(
     })
 }
 
-fn font(size: u32) -> TextStyle<'static> {
+pub(crate) fn font(size: u32) -> TextStyle<'static> {
     TextStyle::from((FONT_FAMILY, size).into_font()).color(&BLACK)
 }
 

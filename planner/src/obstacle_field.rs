@@ -184,7 +184,9 @@ pub fn min_distances(
     other_speed_mps: f64,
     other_shape: &VehicleShape,
 ) -> MinDistances {
-    let length_m = params.min_distance_length.half_sum_m(&me.shape, other_shape);
+    let length_m = params
+        .min_distance_length
+        .half_sum_m(&me.shape, other_shape);
     let (a_me, a_other) = (
         me.shape.max_brake_decel_mps2,
         other_shape.max_brake_decel_mps2,
@@ -361,7 +363,11 @@ impl ObstacleField {
             HeadingForm::Rotation => self.cos_heading * dx + self.sin_heading * (y_m - self.y_m),
             HeadingForm::PaperCorrelation => dx,
         };
-        if along >= 0.0 { Side::Front } else { Side::Rear }
+        if along >= 0.0 {
+            Side::Front
+        } else {
+            Side::Rear
+        }
     }
 
     /// The exponent q (U = A·exp(−q)) and ∂q/∂x, ∂q/∂y and ∂q/∂σ_x of the point's side.
@@ -601,7 +607,10 @@ mod tests {
             .unwrap();
         let expected = psi * field.sigma_lateral_m / field.sigma_rear_m * (-r);
         assert!((ridge_y - expected).abs() < 2e-4, "{ridge_y} vs {expected}");
-        assert!(ridge_y.abs() < 0.2 * (psi * r).abs(), "a rotation would put it at −ψ r");
+        assert!(
+            ridge_y.abs() < 0.2 * (psi * r).abs(),
+            "a rotation would put it at −ψ r"
+        );
         // At ψ = 0 both forms agree.
         let rotation = ObstacleField::new(&forms()[0], me(15.0), 0.0, 0.0, 0.0, 15.0, &shape);
         let paper = ObstacleField {

@@ -233,7 +233,7 @@ impl Default for PlannerParams {
             // their own lanes barely touch each other's interaction term (Eq. 10). With 0.002 the
             // tiny cross-lane term tipped the urgent merge into the ego yielding and the obstacle
             // accelerating, well before either car had moved laterally (docs/reproduction.md).
-            obstacle_epsilon: 3e-4,
+            obstacle_epsilon: 5e-4,
             obstacle_lateral_safety_m: 3.5,
             obstacle_fraction_at_min_distance: 0.1,
             // The 3-second following rule of driver manuals: the follower's D_min is
@@ -243,7 +243,7 @@ impl Default for PlannerParams {
             // rate to survive the perturbations; with 3.5 s the six-car `dense_merge` spreads
             // out so much that its last car is still in the merge section after 30 s).
             // docs/reproduction.md, "Calibration".
-            obstacle_time_gap_s: 3.0,
+            obstacle_time_gap_s: 2.0,
             ego_mass_factor: 1.0,
             other_mass_factor: 1.0,
             obstacle_heading_form: HeadingForm::Rotation,
@@ -274,17 +274,17 @@ impl Default for PlannerParams {
             // gap. More buys little depth (w3 = 25: 13.3 instead of 13.4 m/s) and from w3 = 30
             // (29 holds) the non-convex term tips a perturbed merge (obstacle at 16 m/s) into
             // the ego yielding instead (docs/reproduction.md).
-            interaction_weight: 15.0,
+            interaction_weight: 12.0,
             // The term acts out to U ≈ 0.02, about 1.3 D_min (exp(−q) = 0.02 ⇔ q = 3.9 against
             // q = 2.3 at D_min for the default fraction 0.1): a little beyond the safety
             // distance, still fading a lane away (see `obstacle_epsilon`).
             interaction_floor: 0.02,
-            interaction_time_gap_s: 3.0,
-            interaction_epsilon: 3e-4,
+            interaction_time_gap_s: 2.0,
+            interaction_epsilon: 5e-4,
             interaction_lateral_safety_m: 3.5,
             interaction_fraction_at_min_distance: 0.1,
             interaction_slp_reading: SlpReading::ArcLength,
-            interaction_roles_from_order_now: false,
+            interaction_roles_from_order_now: true,
             interaction_rear_only: true,
             interaction_slows_only: false,
             trust_region_mps: 2.0,
@@ -297,8 +297,8 @@ impl Default for PlannerParams {
             solver_max_iterations: 50,
             solver_tolerance: 1e-7,
             max_shared_path_age_s: 0.5,
-            prediction: PredictionModel::ConstantVelocity,
-            risk_weight: 10.0,
+            prediction: PredictionModel::LaneFollowing,
+            risk_weight: 39.0,
             fallback_decel_mps2: 2.0,
         }
     }
@@ -324,7 +324,10 @@ impl PlannerParams {
             ("obstacle_epsilon", self.obstacle_epsilon),
             ("interaction_floor", self.interaction_floor),
             ("interaction_epsilon", self.interaction_epsilon),
-            ("interaction_lateral_safety_m", self.interaction_lateral_safety_m),
+            (
+                "interaction_lateral_safety_m",
+                self.interaction_lateral_safety_m,
+            ),
             ("obstacle_lateral_safety_m", self.obstacle_lateral_safety_m),
             ("ego_mass_factor", self.ego_mass_factor),
             ("other_mass_factor", self.other_mass_factor),

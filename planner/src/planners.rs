@@ -6,7 +6,7 @@
 //! | kind          | speeds                                                                 |
 //! |---------------|------------------------------------------------------------------------|
 //! | `pf-cs`       | constant V_target (Wang et al. 2022 baseline)                          |
-//! | `pf-sp`       | risk-aware speed planning without V2V (the paper's baseline, after Wu et al. 2022): travel time, target speed and w_R Σ U along its own path, U the others' path field (Eq. 4 with the path-field parameters) at their predicted positions |
+//! | `pf-sp`       | risk-aware speed planning without V2V (the paper's baseline, after Wu et al. 2022): travel time, target speed and w_R Σ U along its own path, U the others' path field (Eq. 4 with the path-field parameters) at their predicted positions; the risk only lowers the speed (capped at max(V_target, v_0 − a_max t)) |
 //! | `pf-sp-eq10`  | Eq. 10 with w3 = 0: travel time, target speed, friction limit (a control: on a straight road it equals PF-CS) |
 //! | `pf-iso`      | Eq. 10 with the received shared local paths (a prediction for a neighbour whose SLP is missing or stale) |
 //! | `pf-iso-pred` | Eq. 10 with every neighbour predicted (no V2V): what V2V buys         |
@@ -477,8 +477,13 @@ impl PfPlanner {
                     req.mu,
                     params.speed_limit_mps,
                 );
-                if kind.is_interactive() && params.interaction_slows_only {
-                    // The interaction may only slow the vehicle: cap at V_target, or at a
+                let slows_only = match kind {
+                    // Risk-aware speed planning lowers the speed for risk; it never races.
+                    PlannerKind::PfSp => true,
+                    _ => kind.is_interactive() && params.interaction_slows_only,
+                };
+                if slows_only {
+                    // The non-convex term may only slow the vehicle: cap at V_target, or at a
                     // comfortable deceleration from the current speed if that is higher.
                     let decel_mps = params.max_accel_mps2 * params.step_time_s;
                     for (i, v) in max_speeds_mps.iter_mut().enumerate() {

@@ -51,14 +51,13 @@ impl SpeedProfile {
                     "times must be finite, >= 0 and increasing",
                 ));
             }
-            if !(v_mps.is_finite() && (MIN_PROFILE_SPEED_MPS..=MAX_PROFILE_SPEED_MPS).contains(&v_mps))
+            if !(v_mps.is_finite()
+                && (MIN_PROFILE_SPEED_MPS..=MAX_PROFILE_SPEED_MPS).contains(&v_mps))
             {
                 return Err(bad(
                     format!("{what}.speed_profile[{i}] speed"),
                     v_mps,
-                    &format!(
-                        "must lie in [{MIN_PROFILE_SPEED_MPS}, {MAX_PROFILE_SPEED_MPS}] m/s"
-                    ),
+                    &format!("must lie in [{MIN_PROFILE_SPEED_MPS}, {MAX_PROFILE_SPEED_MPS}] m/s"),
                 ));
             }
             previous_t_s = t_s;
@@ -145,10 +144,16 @@ mod tests {
             (vec![[0.0, 15.0], [0.0, 14.0]], "speed_profile[1] time"),
             (vec![[0.0, 0.0]], "speed_profile[0] speed"),
             (vec![[f64::NAN, 10.0]], "speed_profile[0] time"),
-            (vec![[0.0, 10.0], [1.0, f64::INFINITY]], "speed_profile[1] speed"),
+            (
+                vec![[0.0, 10.0], [1.0, f64::INFINITY]],
+                "speed_profile[1] speed",
+            ),
         ];
         for (points, field) in cases {
-            let err = SpeedProfile { points }.validate("x").unwrap_err().to_string();
+            let err = SpeedProfile { points }
+                .validate("x")
+                .unwrap_err()
+                .to_string();
             assert!(err.contains(field), "{err}");
         }
     }

@@ -160,11 +160,17 @@ impl Scenario {
     }
 
     /// `sim.planner` = the set's parameters with the overrides on top.
-    fn apply_parameter_set(&mut self, origin: &str, text: Option<&str>) -> Result<(), ScenarioError> {
+    fn apply_parameter_set(
+        &mut self,
+        origin: &str,
+        text: Option<&str>,
+    ) -> Result<(), ScenarioError> {
         self.sim.planner = planner_params_with_overrides(self.params, &self.planner_overrides)
             .map_err(|message| ScenarioError::Invalid {
                 origin: origin.to_string(),
-                line: Line(text.and_then(|t| line_of(t, &["sim".to_string(), "planner".to_string()]))),
+                line: Line(
+                    text.and_then(|t| line_of(t, &["sim".to_string(), "planner".to_string()])),
+                ),
                 field: Some("sim.planner".into()),
                 message: format!("[sim.planner] on top of the {} set: {message}", self.params),
             })?;

@@ -108,7 +108,8 @@ impl PaperMetrics {
 
     /// Adds the next sample (the caller checks finiteness and increasing time).
     pub fn push(&mut self, s: &MetricsSample) {
-        if self.slowing_onset_s.is_none() && s.speed_mps < self.target_speed_mps - SLOWING_THRESHOLD_MPS
+        if self.slowing_onset_s.is_none()
+            && s.speed_mps < self.target_speed_mps - SLOWING_THRESHOLD_MPS
         {
             self.slowing_onset_s = Some(s.t_s);
         }

@@ -71,6 +71,10 @@ enum Command {
     Sweep(SweepArgs),
     /// Combine the --json files of the shards of one sweep into the aggregate of the whole sweep.
     MergeResults(MergeResultsArgs),
+    /// Sensitivity grid: every planner on the same instances under {obstacles predicted in
+    /// Eq. 7 on/off} × {sub-steps on/off} × path time gap τ × interaction time gap τ_I, with
+    /// paired differences against the first planner.
+    Grid(GridArgs),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -226,6 +230,7 @@ fn main() -> ExitCode {
         Some(Command::Scenario(cmd)) => cmd_scenario(&cmd),
         Some(Command::Sweep(args)) => cmd_sweep(&args),
         Some(Command::MergeResults(args)) => cmd_merge_results(&args),
+        Some(Command::Grid(args)) => cmd_grid(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -491,6 +496,30 @@ fn comparison_table(summaries: &[RunSummary]) -> String {
                 .map(|v| v.yaw_rate_sign_changes.to_string())
                 .unwrap_or_default()
         });
+        let paper = |s: &RunSummary| get(s).and_then(|v| v.paper_metrics);
+        let opt = |value: Option<f64>, digits: usize| {
+            value
+                .map(|x| format!("{x:.digits$}"))
+                .unwrap_or_else(|| "-".into())
+        };
+        row(&format!("{name} slowing onset s"), &|s| {
+            opt(paper(s).and_then(|p| p.slowing_onset_s), 2)
+        });
+        row(&format!("{name} RMS r merge zone"), &|s| {
+            opt(paper(s).and_then(|p| p.merge_zone_rms_yaw_rate_radps), 4)
+        });
+        row(&format!("{name} RMS r outside"), &|s| {
+            opt(
+                paper(s).and_then(|p| p.outside_merge_zone_rms_yaw_rate_radps),
+                4,
+            )
+        });
+        row(&format!("{name} max lane offset m"), &|s| {
+            opt(paper(s).map(|p| p.max_abs_lane_offset_m), 2)
+        });
+        row(&format!("{name} crosses divider x m"), &|s| {
+            opt(paper(s).and_then(|p| p.divider_crossing).map(|c| c.x_m), 1)
+        });
     }
     out
 }
@@ -722,6 +751,172 @@ fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> {
     }
     if !args.quiet {
         out!("{}", merged.table());
+    }
+    Ok(())
+}
+
+#[derive(Args, Debug)]
+struct GridArgs {
+    /// Built-in scenario name or path to a scenario TOML file.
+    #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
+    scenario: String,
+    /// Base parameter set of every cell (the four grid parameters are set on top of it).
+    #[arg(long, value_name = "SET", value_parser = parse_params)]
+    params: Option<ParameterSet>,
+    /// Planners, comma-separated; the first is the reference of the paired differences.
+    #[arg(long, value_delimiter = ',', value_parser = parse_planner,
+          default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
+    planners: Vec<PlannerKind>,
+    /// Path-field time gaps τ (s), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "0,1,3", value_parser = parse_gap)]
+    path_gaps: Vec<f64>,
+    /// Interaction time gaps τ_I (s), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,2,3", value_parser = parse_gap)]
+    interaction_gaps: Vec<f64>,
+    /// Instances per cell: 0 runs the nominal scenario only; N runs the instances a sweep
+    /// with --seed would (instance i with seed SplitMix64::derive(seed, i)).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    runs: u64,
+    /// Sweep seed of the drawn instances.
+    #[arg(long, default_value_t = 0, value_name = "K")]
+    seed: u64,
+    /// Vehicle whose figures the table and the figure compare.
+    #[arg(long, default_value = "obstacle", value_name = "NAME")]
+    vehicle: String,
+    /// Write every run (one line per run and vehicle) here.
+    #[arg(long, value_name = "PATH")]
+    csv: Option<PathBuf>,
+    /// Write the runs and the paired differences as JSON here.
+    #[arg(long, value_name = "PATH")]
+    json: Option<PathBuf>,
+    /// Write the figure (heat maps of the mean ratio of the vehicle's peak yaw rate to the
+    /// first planner's) here.
+    #[arg(long, value_name = "PATH")]
+    plot: Option<PathBuf>,
+    /// Worker threads [default: one per core].
+    #[arg(long, value_name = "N", value_parser = parse_threads)]
+    threads: Option<usize>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+fn parse_gap(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() && (0.0..=10.0).contains(&v) => Ok(v),
+        _ => Err("expected a time gap in [0, 10] s".into()),
+    }
+}
+
+/// Most instances a grid cell may run (the default grid runs 36 cells × planners of them).
+const MAX_GRID_RUNS: u64 = 10_000;
+
+fn cmd_grid(args: &GridArgs) -> Result<(), Failure> {
+    use mergesim::grid::{GridAxes, GridMetric, GridPlan, job_count, run_grid};
+    let scenario = load_scenario(&args.scenario, args.params)?;
+    if !scenario.vehicles.iter().any(|v| v.name == args.vehicle) {
+        return Err(input(anyhow!(
+            "--vehicle {:?}: no such vehicle in scenario {} (vehicles: {})",
+            args.vehicle,
+            scenario.name,
+            scenario
+                .vehicles
+                .iter()
+                .map(|v| v.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
+    if args.runs > MAX_GRID_RUNS {
+        return Err(input(anyhow!(
+            "--runs {}: at most {MAX_GRID_RUNS} instances per cell",
+            args.runs
+        )));
+    }
+    for (path, what) in [
+        (args.csv.as_deref(), "--csv"),
+        (args.json.as_deref(), "--json"),
+        (args.plot.as_deref(), "--plot"),
+    ] {
+        if let Some(path) = path {
+            check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
+        }
+    }
+    if args.plot.is_some() && args.planners.len() < 2 {
+        return Err(input(anyhow!(
+            "--plot: the figure compares planners with the first; give at least two"
+        )));
+    }
+    let plan = GridPlan {
+        axes: GridAxes {
+            path_time_gap_s: args.path_gaps.clone(),
+            interaction_time_gap_s: args.interaction_gaps.clone(),
+            ..GridAxes::default()
+        },
+        scenario,
+        planners: args.planners.clone(),
+        runs: args.runs,
+        seed: args.seed,
+        threads: args.threads,
+    };
+    let bar = if !args.quiet && std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(job_count(&plan));
+        let style = indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:30}] {pos}/{len} runs, {per_sec}, ETA {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+        bar.set_style(style);
+        bar.set_message(format!("grid {}", plan.scenario.name));
+        bar
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let outcome = run_grid(&plan, &|| bar.inc(1)).map_err(|e| run_failure(anyhow!(e)))?;
+    bar.finish_and_clear();
+    let peak = outcome.paired_differences(&args.vehicle, GridMetric::PeakYawRate);
+    let zone = outcome.paired_differences(&args.vehicle, GridMetric::MergeZoneRmsYawRate);
+    if let Some(path) = &args.csv {
+        write_output(path, &outcome.csv())?;
+    }
+    if let Some(path) = &args.json {
+        let value = serde_json::json!({
+            "grid": &outcome,
+            "vehicle": &args.vehicle,
+            "paired_peak_yaw_rate": &peak,
+            "paired_merge_zone_rms_yaw_rate": &zone,
+        });
+        let text = serde_json::to_string_pretty(&value).map_err(run_failure)?;
+        write_output(path, &text)?;
+    }
+    if let Some(path) = &args.plot {
+        mergesim::grid_plot::write_grid_png(path, &outcome, &args.vehicle, GridMetric::PeakYawRate)
+            .map_err(run_failure)?;
+    }
+    if !args.quiet {
+        outln!(
+            "grid {} ({} set), {} instance(s) per cell, vehicle {}: mean of each planner / mean of {} \
+             (peak |r|; RMS r in the merge zone), collisions",
+            outcome.scenario,
+            outcome.params,
+            outcome.runs.max(1),
+            args.vehicle,
+            outcome.planners[0]
+        );
+        let ratio = |d: &mergesim::grid::PairedDifference| match (d.mean, d.reference_mean) {
+            (Some(a), Some(b)) if b > 0.0 => format!("{:.2}", a / b),
+            _ => "-".into(),
+        };
+        for (p, z) in peak.iter().zip(&zone) {
+            outln!(
+                "{:<22} {:<12} peak {:>5}  zone {:>5}  collisions {}",
+                p.cell.label(),
+                p.planner,
+                ratio(p),
+                ratio(z),
+                p.collisions
+            );
+        }
+        outln!("wall time {:.1} s", outcome.wall_time_s);
     }
     Ok(())
 }

@@ -150,7 +150,6 @@ pub(super) struct CachedSolver {
     solver: DefaultSolver<f64>,
 }
 
-
 pub(super) fn solver_failed(status: impl Into<String>) -> PlannerError {
     PlannerError::SolverFailed {
         problem: "speed_optimisation".into(),

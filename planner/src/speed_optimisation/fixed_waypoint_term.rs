@@ -169,8 +169,15 @@ mod tests {
             let mut down = v.clone();
             down[j] -= h;
             let fd = (term.value(&up) - term.value(&down)) / (2.0 * h);
-            assert!((g[j] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "j = {j}: {} vs {fd}", g[j]);
-            assert!(g[j] >= 0.0, "a faster ego widens its D_min: the term grows with v");
+            assert!(
+                (g[j] - fd).abs() < 1e-6 * (1.0 + fd.abs()),
+                "j = {j}: {} vs {fd}",
+                g[j]
+            );
+            assert!(
+                g[j] >= 0.0,
+                "a faster ego widens its D_min: the term grows with v"
+            );
         }
         assert!(g.iter().any(|x| *x > 1e-3), "the term must act: {g:?}");
         // At or below the other's speed D_min is on its clamp: nothing left to gain.

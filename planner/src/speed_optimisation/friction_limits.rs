@@ -40,4 +40,3 @@ mod tests {
         assert_eq!(straight, vec![30.0]);
     }
 }
-

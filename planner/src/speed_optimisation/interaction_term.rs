@@ -139,7 +139,15 @@ mod tests {
             speed_mps: 15.0,
             shape: VehicleShape::default(),
         };
-        let base = ObstacleField::new(&params.interaction_field(), me, 0.0, 0.0, 0.0, 20.0, &VehicleShape::default());
+        let base = ObstacleField::new(
+            &params.interaction_field(),
+            me,
+            0.0,
+            0.0,
+            0.0,
+            20.0,
+            &VehicleShape::default(),
+        );
         let n = 10;
         let dt = params.step_time_s;
         // The other vehicle passes at 20 m/s while moving from the lower to the upper lane.
@@ -156,7 +164,15 @@ mod tests {
                 .collect(),
         )
         .unwrap();
-        let term = InteractionTerm::new(path, [1.0, 0.0], dt, Aggregate::LogFloored { floor: params.interaction_floor }, fields);
+        let term = InteractionTerm::new(
+            path,
+            [1.0, 0.0],
+            dt,
+            Aggregate::LogFloored {
+                floor: params.interaction_floor,
+            },
+            fields,
+        );
         let v: Vec<f64> = (0..n).map(|i| 14.0 + 0.1 * i as f64).collect();
         let (_, g) = term.value_and_gradient(&v);
         let h = 1e-6;
@@ -177,5 +193,4 @@ mod tests {
             "the term must act: {g:?}"
         );
     }
-
 }

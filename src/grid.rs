@@ -1,0 +1,585 @@
+//! The sensitivity grid (`merge_sim grid`): how the comparison of the planners depends on the
+//! four path-generation and interaction choices that shape it.
+//!
+//! Axes (each cell applies them on top of the scenario's parameter set):
+//! - `predict_obstacles_in_path`: the others at their constant-velocity positions in Eq. 7, or
+//!   at their current positions (the paper's reading);
+//! - sub-steps: the Eq. 7 step integrated in adaptive sub-steps of at most 1 m
+//!   (`max_substep_m` = 1, `substep_max_turn_rad` = 0.1) or in one gradient step per waypoint
+//!   (the paper's);
+//! - the path field's time gap τ (`obstacle_time_gap_s`): 0 (the paper's D_min), 1, 3 s;
+//! - the interaction term's time gap τ_I (`interaction_time_gap_s`): 1, 2, 3 s.
+//!
+//! Every cell runs every planner on the same instances (the nominal scenario, or `runs` drawn
+//! instances with the seeds a sweep uses), so the differences between planners are paired.
+//! Planners without the interaction term (PF-CS, PF-SP, PF-SP-EQ10) do not depend on τ_I: they
+//! run once per (prediction, sub-steps, τ) and their rows are shared by the τ_I cells — the
+//! separation of the two parameter families makes that exact (tested).
+
+use std::time::Instant;
+
+use planner::{PlannerKind, PlannerParams};
+use rayon::prelude::*;
+use scenarios::Scenario;
+use serde::{Deserialize, Serialize};
+use sim::recording::Recorder;
+use sim::{RunOptions, World};
+
+use crate::sweep::instance_seed;
+
+/// One cell of the grid.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GridCell {
+    /// Obstacles at their predicted positions in Eq. 7.
+    pub predict_obstacles_in_path: bool,
+    /// Adaptive 1 m sub-steps in Eq. 7 (false: one gradient step per waypoint).
+    pub substeps: bool,
+    /// τ of the path field (s).
+    pub path_time_gap_s: f64,
+    /// τ_I of the interaction term (s).
+    pub interaction_time_gap_s: f64,
+}
+
+impl GridCell {
+    /// The parameters of this cell on top of `base`.
+    pub fn apply(&self, base: &PlannerParams) -> PlannerParams {
+        let (max_substep_m, substep_max_turn_rad) = if self.substeps {
+            (1.0, 0.1)
+        } else {
+            (1000.0, 0.0)
+        };
+        PlannerParams {
+            predict_obstacles_in_path: self.predict_obstacles_in_path,
+            max_substep_m,
+            substep_max_turn_rad,
+            obstacle_time_gap_s: self.path_time_gap_s,
+            interaction_time_gap_s: self.interaction_time_gap_s,
+            ..base.clone()
+        }
+    }
+
+    /// A short label, e.g. `pred+sub τ3 τI2`.
+    pub fn label(&self) -> String {
+        format!(
+            "{}{} τ{} τI{}",
+            if self.predict_obstacles_in_path {
+                "pred"
+            } else {
+                "now"
+            },
+            if self.substeps { "+sub" } else { "" },
+            self.path_time_gap_s,
+            self.interaction_time_gap_s
+        )
+    }
+}
+
+/// The values of each axis.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GridAxes {
+    /// `predict_obstacles_in_path` values.
+    pub predict_obstacles_in_path: Vec<bool>,
+    /// Sub-step values.
+    pub substeps: Vec<bool>,
+    /// τ values (s).
+    pub path_time_gap_s: Vec<f64>,
+    /// τ_I values (s).
+    pub interaction_time_gap_s: Vec<f64>,
+}
+
+impl Default for GridAxes {
+    fn default() -> Self {
+        Self {
+            predict_obstacles_in_path: vec![false, true],
+            substeps: vec![false, true],
+            path_time_gap_s: vec![0.0, 1.0, 3.0],
+            interaction_time_gap_s: vec![1.0, 2.0, 3.0],
+        }
+    }
+}
+
+impl GridAxes {
+    /// Every cell, prediction slowest-varying, τ_I fastest.
+    pub fn cells(&self) -> Vec<GridCell> {
+        let mut cells = Vec::new();
+        for &predict_obstacles_in_path in &self.predict_obstacles_in_path {
+            for &substeps in &self.substeps {
+                for &path_time_gap_s in &self.path_time_gap_s {
+                    for &interaction_time_gap_s in &self.interaction_time_gap_s {
+                        cells.push(GridCell {
+                            predict_obstacles_in_path,
+                            substeps,
+                            path_time_gap_s,
+                            interaction_time_gap_s,
+                        });
+                    }
+                }
+            }
+        }
+        cells
+    }
+}
+
+/// What the grid measures of one vehicle in one run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VehicleFigures {
+    /// Vehicle name.
+    pub vehicle: String,
+    /// Peak |yaw rate| (rad/s).
+    pub peak_yaw_rate_radps: f64,
+    /// Yaw-rate RMS inside the merge zone (rad/s).
+    pub merge_zone_rms_yaw_rate_radps: Option<f64>,
+    /// Yaw-rate RMS outside it (rad/s).
+    pub outside_merge_zone_rms_yaw_rate_radps: Option<f64>,
+    /// Peak |sideslip| (rad).
+    pub peak_sideslip_rad: f64,
+    /// Lowest speed (m/s).
+    pub min_speed_mps: f64,
+    /// First time 0.1 m/s below its target (s).
+    pub slowing_onset_s: Option<f64>,
+    /// Path length (m).
+    pub path_length_m: f64,
+    /// Involved in a collision.
+    pub collided: bool,
+}
+
+/// One run of the grid.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GridRow {
+    /// The cell.
+    pub cell: GridCell,
+    /// Planner.
+    pub planner: String,
+    /// Instance index (0 for the nominal scenario).
+    pub instance: u64,
+    /// Seed of the instance; null for the nominal scenario.
+    pub seed: Option<u64>,
+    /// Collision episodes (vehicle–vehicle and road edge); null if the run failed.
+    pub collisions: Option<u64>,
+    /// Why the run failed, if it did.
+    pub error: Option<String>,
+    /// Per-vehicle figures (empty if the run failed).
+    pub vehicles: Vec<VehicleFigures>,
+}
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct GridPlan {
+    /// The scenario (its parameter set is the base of every cell).
+    pub scenario: Scenario,
+    /// Planners, the first being the reference of the paired differences.
+    pub planners: Vec<PlannerKind>,
+    /// The axes.
+    pub axes: GridAxes,
+    /// 0: the nominal scenario only; else this many drawn instances.
+    pub runs: u64,
+    /// Sweep seed of the drawn instances.
+    pub seed: u64,
+    /// Worker threads (None: one per core).
+    pub threads: Option<usize>,
+}
+
+/// The figure a paired comparison looks at, for one vehicle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GridMetric {
+    /// Peak |yaw rate|.
+    PeakYawRate,
+    /// Yaw-rate RMS inside the merge zone.
+    MergeZoneRmsYawRate,
+}
+
+impl GridMetric {
+    fn of(self, v: &VehicleFigures) -> Option<f64> {
+        match self {
+            GridMetric::PeakYawRate => Some(v.peak_yaw_rate_radps),
+            GridMetric::MergeZoneRmsYawRate => v.merge_zone_rms_yaw_rate_radps,
+        }
+    }
+}
+
+/// Paired difference of one planner against the reference in one cell, for one vehicle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PairedDifference {
+    /// The cell.
+    pub cell: GridCell,
+    /// The planner compared.
+    pub planner: String,
+    /// The reference planner.
+    pub reference: String,
+    /// The metric.
+    pub metric: GridMetric,
+    /// Instances where both runs completed.
+    pub pairs: u64,
+    /// Mean of the planner's metric.
+    pub mean: Option<f64>,
+    /// Mean of the reference's metric.
+    pub reference_mean: Option<f64>,
+    /// Mean of (planner − reference).
+    pub mean_difference: Option<f64>,
+    /// Standard error of that mean (null with fewer than two pairs).
+    pub standard_error: Option<f64>,
+    /// Instances where the planner's value is lower.
+    pub lower: u64,
+    /// Collisions of the planner's runs in this cell.
+    pub collisions: u64,
+}
+
+/// Runs of one (cell, planner) job.
+struct Job {
+    cell: GridCell,
+    planner: PlannerKind,
+    instance: u64,
+    seed: Option<u64>,
+}
+
+fn figures(outcome: &sim::RunOutcome) -> Vec<VehicleFigures> {
+    outcome
+        .vehicles
+        .iter()
+        .map(|v| {
+            let paper = v.paper_metrics.as_ref();
+            VehicleFigures {
+                vehicle: v.id.clone(),
+                peak_yaw_rate_radps: v.max_abs_yaw_rate_radps,
+                merge_zone_rms_yaw_rate_radps: paper.and_then(|p| p.merge_zone_rms_yaw_rate_radps),
+                outside_merge_zone_rms_yaw_rate_radps: paper
+                    .and_then(|p| p.outside_merge_zone_rms_yaw_rate_radps),
+                peak_sideslip_rad: v.max_abs_sideslip_rad,
+                min_speed_mps: v.min_speed_mps,
+                slowing_onset_s: paper.and_then(|p| p.slowing_onset_s),
+                path_length_m: v.path_length_m,
+                collided: v.collided,
+            }
+        })
+        .collect()
+}
+
+fn run_job(scenario: &Scenario, job: &Job) -> GridRow {
+    let instance = scenario.instance(job.seed);
+    let mut sim_config = instance.sim.clone();
+    sim_config.planner = job.cell.apply(&sim_config.planner);
+    let options = RunOptions {
+        planner_override: Some(job.planner),
+        seed: job.seed.unwrap_or(0),
+        keep_time_series: false,
+    };
+    let result = World::new(
+        sim_config,
+        &instance.vehicles,
+        &options,
+        Recorder::disabled(),
+    )
+    .and_then(|world| world.run(|_| {}));
+    let (collisions, error, vehicles) = match result {
+        Ok(outcome) => (
+            Some((outcome.safety.collisions.len() + outcome.safety.edge_contacts.len()) as u64),
+            None,
+            figures(&outcome),
+        ),
+        Err(e) => (None, Some(e.to_string()), Vec::new()),
+    };
+    GridRow {
+        cell: job.cell,
+        planner: job.planner.name().to_string(),
+        instance: job.instance,
+        seed: job.seed,
+        collisions,
+        error,
+        vehicles,
+    }
+}
+
+/// The grid's result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GridOutcome {
+    /// Scenario name.
+    pub scenario: String,
+    /// Base parameter set.
+    pub params: String,
+    /// The axes.
+    pub axes: GridAxes,
+    /// Planners, the first the reference.
+    pub planners: Vec<String>,
+    /// Instances per cell (0: nominal only).
+    pub runs: u64,
+    /// Sweep seed.
+    pub seed: u64,
+    /// Every run, in cell, planner, instance order.
+    pub rows: Vec<GridRow>,
+    /// Wall time (s).
+    pub wall_time_s: f64,
+}
+
+/// Runs the grid in parallel; `on_run_done` is called after each run (for a progress bar).
+/// The rows do not depend on the number of threads.
+pub fn run_grid(plan: &GridPlan, on_run_done: &(dyn Fn() + Sync)) -> Result<GridOutcome, String> {
+    if plan.planners.is_empty() {
+        return Err("--planners: need at least one planner".into());
+    }
+    let cells = plan.axes.cells();
+    if cells.is_empty() {
+        return Err("the grid has no cell".into());
+    }
+    let instances: Vec<(u64, Option<u64>)> = if plan.runs == 0 {
+        vec![(0, None)]
+    } else {
+        (0..plan.runs)
+            .map(|i| (i, Some(instance_seed(plan.seed, i))))
+            .collect()
+    };
+    // Jobs: interaction-free planners once per (prediction, sub-steps, τ).
+    let mut jobs = Vec::new();
+    for cell in &cells {
+        for &planner in &plan.planners {
+            let representative = if planner.is_interactive() {
+                *cell
+            } else {
+                GridCell {
+                    interaction_time_gap_s: plan.axes.interaction_time_gap_s[0],
+                    ..*cell
+                }
+            };
+            if representative != *cell {
+                continue;
+            }
+            for &(instance, seed) in &instances {
+                jobs.push(Job {
+                    cell: *cell,
+                    planner,
+                    instance,
+                    seed,
+                });
+            }
+        }
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(plan.threads.unwrap_or(0))
+        .stack_size(16 << 20)
+        .build()
+        .map_err(|e| e.to_string())?;
+    let started = Instant::now();
+    let ran: Vec<GridRow> = pool.install(|| {
+        jobs.par_iter()
+            .map(|job| {
+                let row = run_job(&plan.scenario, job);
+                on_run_done();
+                row
+            })
+            .collect()
+    });
+    // Every cell gets a row for every planner and instance (shared rows copied in).
+    let mut rows = Vec::new();
+    for cell in &cells {
+        for &planner in &plan.planners {
+            let source_cell = if planner.is_interactive() {
+                *cell
+            } else {
+                GridCell {
+                    interaction_time_gap_s: plan.axes.interaction_time_gap_s[0],
+                    ..*cell
+                }
+            };
+            for row in ran
+                .iter()
+                .filter(|r| r.cell == source_cell && r.planner == planner.name())
+            {
+                rows.push(GridRow {
+                    cell: *cell,
+                    ..row.clone()
+                });
+            }
+        }
+    }
+    Ok(GridOutcome {
+        scenario: plan.scenario.name.clone(),
+        params: plan.scenario.params.name().to_string(),
+        axes: plan.axes.clone(),
+        planners: plan.planners.iter().map(|p| p.name().to_string()).collect(),
+        runs: plan.runs,
+        seed: plan.seed,
+        rows,
+        wall_time_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// Number of runs [`run_grid`] performs (for the progress bar).
+pub fn job_count(plan: &GridPlan) -> u64 {
+    let cells = plan.axes.cells().len() as u64;
+    let shared_cells = cells / plan.axes.interaction_time_gap_s.len().max(1) as u64;
+    let instances = plan.runs.max(1);
+    plan.planners
+        .iter()
+        .map(|p| {
+            if p.is_interactive() {
+                cells
+            } else {
+                shared_cells
+            }
+        })
+        .sum::<u64>()
+        * instances
+}
+
+impl GridOutcome {
+    /// Paired differences of every planner against the first, per cell, for `vehicle`.
+    pub fn paired_differences(&self, vehicle: &str, metric: GridMetric) -> Vec<PairedDifference> {
+        let Some(reference) = self.planners.first() else {
+            return Vec::new();
+        };
+        let value = |row: &GridRow| {
+            row.vehicles
+                .iter()
+                .find(|v| v.vehicle == vehicle)
+                .and_then(|v| metric.of(v))
+        };
+        let mut out = Vec::new();
+        for cell in self.axes.cells() {
+            let in_cell: Vec<&GridRow> = self.rows.iter().filter(|r| r.cell == cell).collect();
+            for planner in &self.planners[1..] {
+                let mut values = Vec::new();
+                let mut diffs = Vec::new();
+                let mut reference_values = Vec::new();
+                let mut lower = 0;
+                for row in in_cell.iter().filter(|r| &r.planner == planner) {
+                    let other = in_cell
+                        .iter()
+                        .find(|r| &r.planner == reference && r.instance == row.instance);
+                    if let (Some(a), Some(b)) = (value(row), other.and_then(|r| value(r))) {
+                        values.push(a);
+                        reference_values.push(b);
+                        diffs.push(a - b);
+                        if a < b {
+                            lower += 1;
+                        }
+                    }
+                }
+                let collisions = in_cell
+                    .iter()
+                    .filter(|r| &r.planner == planner)
+                    .map(|r| r.collisions.unwrap_or(0))
+                    .sum();
+                out.push(PairedDifference {
+                    cell,
+                    planner: planner.clone(),
+                    reference: reference.clone(),
+                    metric,
+                    pairs: diffs.len() as u64,
+                    mean: mean(&values),
+                    reference_mean: mean(&reference_values),
+                    mean_difference: mean(&diffs),
+                    standard_error: standard_error(&diffs),
+                    lower,
+                    collisions,
+                });
+            }
+        }
+        out
+    }
+
+    /// The rows as CSV, one line per run and vehicle.
+    pub fn csv(&self) -> String {
+        let mut text = String::from(
+            "predict_obstacles_in_path,substeps,path_time_gap_s,interaction_time_gap_s,planner,\
+             instance,seed,collisions,error,vehicle,peak_yaw_rate_radps,\
+             merge_zone_rms_yaw_rate_radps,outside_merge_zone_rms_yaw_rate_radps,\
+             peak_sideslip_rad,min_speed_mps,slowing_onset_s,path_length_m,collided\n",
+        );
+        let opt = |v: Option<f64>| v.map(|x| format!("{x}")).unwrap_or_default();
+        for row in &self.rows {
+            let c = row.cell;
+            let head = format!(
+                "{},{},{},{},{},{},{},{},{}",
+                c.predict_obstacles_in_path,
+                c.substeps,
+                c.path_time_gap_s,
+                c.interaction_time_gap_s,
+                row.planner,
+                row.instance,
+                row.seed.map(|s| s.to_string()).unwrap_or_default(),
+                row.collisions.map(|n| n.to_string()).unwrap_or_default(),
+                row.error
+                    .as_deref()
+                    .map(|e| format!("\"{}\"", e.replace('"', "'")))
+                    .unwrap_or_default(),
+            );
+            if row.vehicles.is_empty() {
+                text.push_str(&format!("{head},,,,,,,,,\n"));
+            }
+            for v in &row.vehicles {
+                text.push_str(&format!(
+                    "{head},{},{},{},{},{},{},{},{},{}\n",
+                    v.vehicle,
+                    v.peak_yaw_rate_radps,
+                    opt(v.merge_zone_rms_yaw_rate_radps),
+                    opt(v.outside_merge_zone_rms_yaw_rate_radps),
+                    v.peak_sideslip_rad,
+                    v.min_speed_mps,
+                    opt(v.slowing_onset_s),
+                    v.path_length_m,
+                    v.collided
+                ));
+            }
+        }
+        text
+    }
+}
+
+fn mean(values: &[f64]) -> Option<f64> {
+    (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+}
+
+fn standard_error(values: &[f64]) -> Option<f64> {
+    if values.len() < 2 {
+        return None;
+    }
+    let n = values.len() as f64;
+    let m = values.iter().sum::<f64>() / n;
+    let var = values.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0);
+    Some((var / n).sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_grid_has_36_cells_and_counts_shared_runs_once() {
+        let axes = GridAxes::default();
+        assert_eq!(axes.cells().len(), 36);
+        let plan = GridPlan {
+            scenario: Scenario::load("urgent_merge").unwrap(),
+            planners: vec![PlannerKind::PfCs, PlannerKind::PfIso],
+            axes,
+            runs: 0,
+            seed: 0,
+            threads: None,
+        };
+        // PF-CS: 12 cells (τ_I shared), PF-ISO: 36.
+        assert_eq!(job_count(&plan), 48);
+    }
+
+    #[test]
+    fn a_cell_sets_exactly_its_four_parameters() {
+        let base = PlannerParams::default();
+        let cell = GridCell {
+            predict_obstacles_in_path: false,
+            substeps: false,
+            path_time_gap_s: 0.0,
+            interaction_time_gap_s: 1.0,
+        };
+        let p = cell.apply(&base);
+        assert!(!p.predict_obstacles_in_path);
+        assert_eq!((p.max_substep_m, p.substep_max_turn_rad), (1000.0, 0.0));
+        assert_eq!(p.obstacle_time_gap_s, 0.0);
+        assert_eq!(p.interaction_time_gap_s, 1.0);
+        let back = GridCell {
+            predict_obstacles_in_path: base.predict_obstacles_in_path,
+            substeps: true,
+            path_time_gap_s: base.obstacle_time_gap_s,
+            interaction_time_gap_s: base.interaction_time_gap_s,
+        }
+        .apply(&p);
+        assert_eq!(back, base);
+    }
+}
