@@ -87,6 +87,18 @@ pub struct GridAxes {
     pub interaction_time_gap_s: Vec<f64>,
 }
 
+impl GridAxes {
+    /// The single cell of `params`' own values (a paired study of the planners as configured).
+    pub fn of_params(params: &PlannerParams) -> Self {
+        Self {
+            predict_obstacles_in_path: vec![params.predict_obstacles_in_path],
+            substeps: vec![params.max_substep_m <= 1.0 && params.substep_max_turn_rad > 0.0],
+            path_time_gap_s: vec![params.obstacle_time_gap_s],
+            interaction_time_gap_s: vec![params.interaction_time_gap_s],
+        }
+    }
+}
+
 impl Default for GridAxes {
     fn default() -> Self {
         Self {
@@ -183,17 +195,67 @@ pub struct GridPlan {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum GridMetric {
-    /// Peak |yaw rate|.
+    /// Peak |yaw rate| (rad/s).
     PeakYawRate,
-    /// Yaw-rate RMS inside the merge zone.
+    /// Yaw-rate RMS inside the merge zone (rad/s).
     MergeZoneRmsYawRate,
+    /// Yaw-rate RMS outside the merge zone (rad/s).
+    OutsideRmsYawRate,
+    /// Peak |sideslip| (rad).
+    PeakSideslip,
+    /// Lowest speed (m/s).
+    MinSpeed,
+    /// First time 0.1 m/s below the target (s); pairs only where both slowed.
+    SlowingOnset,
+    /// Path length (m).
+    PathLength,
 }
 
 impl GridMetric {
+    /// Every metric, in table order.
+    pub const ALL: [GridMetric; 7] = [
+        GridMetric::PeakYawRate,
+        GridMetric::MergeZoneRmsYawRate,
+        GridMetric::OutsideRmsYawRate,
+        GridMetric::PeakSideslip,
+        GridMetric::MinSpeed,
+        GridMetric::SlowingOnset,
+        GridMetric::PathLength,
+    ];
+
+    /// Name with unit, for tables.
+    pub fn label(self) -> &'static str {
+        match self {
+            GridMetric::PeakYawRate => "peak |r| (rad/s)",
+            GridMetric::MergeZoneRmsYawRate => "RMS r merge zone (rad/s)",
+            GridMetric::OutsideRmsYawRate => "RMS r outside (rad/s)",
+            GridMetric::PeakSideslip => "peak |β| (rad)",
+            GridMetric::MinSpeed => "min speed (m/s)",
+            GridMetric::SlowingOnset => "slowing onset (s)",
+            GridMetric::PathLength => "path length (m)",
+        }
+    }
+
+    /// Decimals to print it with.
+    pub fn decimals(self) -> usize {
+        match self {
+            GridMetric::PeakYawRate
+            | GridMetric::MergeZoneRmsYawRate
+            | GridMetric::OutsideRmsYawRate
+            | GridMetric::PeakSideslip => 5,
+            GridMetric::MinSpeed | GridMetric::SlowingOnset | GridMetric::PathLength => 2,
+        }
+    }
+
     fn of(self, v: &VehicleFigures) -> Option<f64> {
         match self {
             GridMetric::PeakYawRate => Some(v.peak_yaw_rate_radps),
             GridMetric::MergeZoneRmsYawRate => v.merge_zone_rms_yaw_rate_radps,
+            GridMetric::OutsideRmsYawRate => v.outside_merge_zone_rms_yaw_rate_radps,
+            GridMetric::PeakSideslip => Some(v.peak_sideslip_rad),
+            GridMetric::MinSpeed => Some(v.min_speed_mps),
+            GridMetric::SlowingOnset => v.slowing_onset_s,
+            GridMetric::PathLength => Some(v.path_length_m),
         }
     }
 }

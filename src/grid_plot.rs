@@ -56,10 +56,7 @@ pub fn write_grid_png(
     let panel_h = top + cell_h * rows.len() as i32 + 40;
     let width = (left + cell_w * cols.len() as i32 + 30) as u32;
     let height = (panel_h * compared.len() as i32 + panel_gap) as u32;
-    let metric_name = match metric {
-        GridMetric::PeakYawRate => "peak |yaw rate|",
-        GridMetric::MergeZoneRmsYawRate => "yaw-rate RMS in the merge zone",
-    };
+    let metric_name = metric.label();
     render_png(path, (width, height), |area| {
         for (k, planner) in compared.iter().enumerate() {
             let y0 = k as i32 * panel_h + 10;

@@ -248,11 +248,11 @@ fn pf_iso_slows_for_a_faster_vehicle_cutting_in_ahead() {
 }
 
 /// A faster vehicle closing in from 25 m behind in the same lane (17 vs 15 m/s, still 15 m
-/// behind at the horizon): with `interaction_rear_only` (the follower is responsible for the
-/// gap) the leader keeps its PF-SP speeds; without it, the follower's field drives the leader's
-/// speeds away from them. (Which way is up to the non-convex term: with the default 3 s time
-/// gap the leader slows, ≈ 0.7 m/s on average, to let the follower "pass through"; with 2.5 s
-/// it was pushed to speed up. Both are what the flag exists to prevent.)
+/// behind at the horizon): when the follower is responsible for the gap — roles fixed from the
+/// order now (the default, for predicted vehicles), or per time slot with
+/// `interaction_rear_only` — the leader keeps the speeds of Eq. 10 without interaction
+/// (PF-SP-EQ10); with neither rule, the follower's field drives the leader's speeds away from
+/// them (which way is up to the non-convex term). That is what the rules exist to prevent.
 #[test]
 fn a_follower_does_not_push_the_leader_when_the_follower_is_responsible() {
     let ego = state(100.0, 5.25, 0.0, 15.0);
@@ -261,9 +261,10 @@ fn a_follower_does_not_push_the_leader_when_the_follower_is_responsible() {
         state: state(75.0, 5.25, 0.0, 17.0),
         shape: VehicleShape::default(),
     }];
-    let mean_speed = |kind: PlannerKind, rear_only: bool| {
+    let mean_speed = |kind: PlannerKind, rear_only: bool, from_order_now: bool| {
         let params = PlannerParams {
             interaction_rear_only: rear_only,
+            interaction_roles_from_order_now: from_order_now,
             ..PlannerParams::default()
         };
         let plan = PfPlanner::new(kind, params, MergeRoad::default())
@@ -272,12 +273,18 @@ fn a_follower_does_not_push_the_leader_when_the_follower_is_responsible() {
             .unwrap();
         plan.path.iter().map(|p| p.speed_mps).sum::<f64>() / plan.path.len() as f64
     };
-    let sp = mean_speed(PlannerKind::PfSp, true);
-    assert!((mean_speed(PlannerKind::PfIsoPred, true) - sp).abs() < 0.05);
-    let pushed = mean_speed(PlannerKind::PfIsoPred, false);
+    let free = mean_speed(PlannerKind::PfSpEq10, true, true);
+    for (rear_only, from_order_now) in [(true, true), (false, true), (true, false)] {
+        let leader = mean_speed(PlannerKind::PfIsoPred, rear_only, from_order_now);
+        assert!(
+            (leader - free).abs() < 0.05,
+            "rear-only {rear_only}, order now {from_order_now}: {leader} vs {free}"
+        );
+    }
+    let pushed = mean_speed(PlannerKind::PfIsoPred, false, false);
     assert!(
-        (pushed - sp).abs() > 0.3,
-        "without rear-only {pushed} vs PF-SP {sp}"
+        (pushed - free).abs() > 0.3,
+        "without either rule {pushed} vs PF-SP-EQ10 {free}"
     );
 }
 

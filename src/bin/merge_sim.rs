@@ -773,6 +773,11 @@ struct GridArgs {
     /// Interaction time gaps τ_I (s), comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1,2,3", value_parser = parse_gap)]
     interaction_gaps: Vec<f64>,
+    /// Run only the parameter set's own cell (its prediction, sub-steps, τ and τ_I): a paired
+    /// study of the planners as configured, with a table of paired differences for every
+    /// vehicle and figure.
+    #[arg(long, conflicts_with_all = ["path_gaps", "interaction_gaps"])]
+    base_only: bool,
     /// Instances per cell: 0 runs the nominal scenario only; N runs the instances a sweep
     /// with --seed would (instance i with seed SplitMix64::derive(seed, i)).
     #[arg(long, default_value_t = 0, value_name = "N")]
@@ -847,12 +852,17 @@ fn cmd_grid(args: &GridArgs) -> Result<(), Failure> {
             "--plot: the figure compares planners with the first; give at least two"
         )));
     }
-    let plan = GridPlan {
-        axes: GridAxes {
+    let axes = if args.base_only {
+        GridAxes::of_params(&scenario.sim.planner)
+    } else {
+        GridAxes {
             path_time_gap_s: args.path_gaps.clone(),
             interaction_time_gap_s: args.interaction_gaps.clone(),
             ..GridAxes::default()
-        },
+        }
+    };
+    let plan = GridPlan {
+        axes,
         scenario,
         planners: args.planners.clone(),
         runs: args.runs,
@@ -916,7 +926,77 @@ fn cmd_grid(args: &GridArgs) -> Result<(), Failure> {
                 p.collisions
             );
         }
+        if outcome.axes.cells().len() == 1 {
+            out!("{}", study_table(&outcome));
+        }
         outln!("wall time {:.1} s", outcome.wall_time_s);
     }
     Ok(())
+}
+
+/// Paired differences of every planner against the first, for every vehicle and figure, and
+/// the collisions of each planner (a single-cell grid).
+fn study_table(outcome: &mergesim::grid::GridOutcome) -> String {
+    use mergesim::grid::GridMetric;
+    let mut out = String::new();
+    let vehicles: Vec<String> = outcome
+        .rows
+        .iter()
+        .flat_map(|r| r.vehicles.iter().map(|v| v.vehicle.clone()))
+        .fold(Vec::new(), |mut acc, v| {
+            if !acc.contains(&v) {
+                acc.push(v);
+            }
+            acc
+        });
+    let reference = &outcome.planners[0];
+    out.push_str(&format!(
+        "paired differences against {reference} (mean ± standard error; n: pairs; lower: \
+         instances where the planner's value is lower)\n"
+    ));
+    for planner in &outcome.planners {
+        let rows: Vec<_> = outcome
+            .rows
+            .iter()
+            .filter(|r| &r.planner == planner)
+            .collect();
+        let collisions: u64 = rows.iter().map(|r| r.collisions.unwrap_or(0)).sum();
+        let colliding_runs = rows
+            .iter()
+            .filter(|r| r.collisions.unwrap_or(0) > 0)
+            .count();
+        let failed = rows.iter().filter(|r| r.error.is_some()).count();
+        out.push_str(&format!(
+            "{planner:<12} collisions {collisions} in {colliding_runs} of {} runs{}\n",
+            rows.len(),
+            if failed > 0 {
+                format!(", {failed} failed")
+            } else {
+                String::new()
+            }
+        ));
+    }
+    for vehicle in &vehicles {
+        for metric in GridMetric::ALL {
+            for d in outcome.paired_differences(vehicle, metric) {
+                let digits = metric.decimals();
+                let fmt = |v: Option<f64>| {
+                    v.map(|x| format!("{x:.digits$}"))
+                        .unwrap_or_else(|| "-".into())
+                };
+                out.push_str(&format!(
+                    "{vehicle:<10} {:<26} {:<12} {:>9} vs {:>9}  diff {:>9} ± {:<7} n {:>3} lower {:>3}\n",
+                    metric.label(),
+                    d.planner,
+                    fmt(d.mean),
+                    fmt(d.reference_mean),
+                    fmt(d.mean_difference),
+                    fmt(d.standard_error),
+                    d.pairs,
+                    d.lower
+                ));
+            }
+        }
+    }
+    out
 }
