@@ -1,41 +1,51 @@
-//! The paper's comparison of PF-CS, PF-SP and PF-ISO (Lin et al., Sec. V; DESIGN §5) on the
-//! built-in urgent merge and on perturbed variants (obstacle start ±3 m, each vehicle's speed
-//! ±1 m/s, μ 0.7 and 0.9; one perturbation at a time), with the same code and parameters for
-//! every planner. Only the findings that hold in this simulator are asserted; the others are
-//! listed, with numbers, in docs/reproduction.md.
+//! The paper's comparison of PF-CS, PF-SP and PF-ISO (Lin et al., Sec. V) on the built-in urgent
+//! merge, with both parameter sets: `paper` (the paper's literal reading) and `mergesim` (ours).
+//! Every parameter is fixed by a criterion that does not look at this comparison
+//! (docs/parameters.md, `planner/tests/calibration.rs`); only the findings that hold are
+//! asserted, the others are reported with numbers and causes in docs/reproduction.md.
 //!
-//! The planner runs with its defaults (`PlannerParams::default()`), which include the two
-//! calibration choices this comparison rests on: obstacles stepped against at their predicted
-//! positions in the path integration, and a 3 s following gap (docs/reproduction.md,
-//! "Calibration").
+//! Variants: the nominal scenario and eight one-at-a-time perturbations (obstacle start ±3 m,
+//! either speed ±1 m/s, μ 0.7 / 0.9), and the worst corner of that box.
 
 mod common;
 
-use mergesim::planner::PlannerKind;
+use mergesim::planner::{ParameterSet, PlannerKind};
 use mergesim::scenarios::Scenario;
-use mergesim::sim::{RunOutcome, TimeSeriesRow};
+use mergesim::sim::RunOutcome;
+use mergesim::sim::metrics::VehicleMetricsSummary;
+use mergesim::sim::paper_metrics::PaperMetricsSummary;
 
 const EGO: &str = "ego";
 const OBSTACLE: &str = "obstacle";
 
-/// A speed drop smaller than this is tracker noise, not braking (m/s).
-const SLOWING_THRESHOLD_MPS: f64 = 0.1;
+/// The obstacle "makes room" in a run where PF-ISO slows it by more than this (m/s); below it
+/// the ego merges far enough ahead that nobody has to interact.
+const MAKES_ROOM_MPS: f64 = 0.5;
 
 fn run(scenario: &Scenario, kind: PlannerKind) -> RunOutcome {
-    common::simulate(scenario, Some(kind), 0, true)
+    common::simulate(scenario, Some(kind), 0, false)
 }
 
-/// `[PF-CS, PF-SP, PF-ISO, PF-ISO-PRED]` on one scenario, two at a time (two cores).
-fn run_all(scenario: &Scenario) -> [RunOutcome; 4] {
-    let pair = |first: PlannerKind, second: PlannerKind| {
-        std::thread::scope(|s| {
-            let other = s.spawn(|| run(scenario, second));
-            (run(scenario, first), other.join().unwrap())
-        })
-    };
-    let (cs, sp) = pair(PlannerKind::PfCs, PlannerKind::PfSp);
-    let (iso, pred) = pair(PlannerKind::PfIso, PlannerKind::PfIsoPred);
-    [cs, sp, iso, pred]
+/// Runs every kind on one scenario, two at a time (two cores).
+fn run_kinds<const N: usize>(scenario: &Scenario, kinds: [PlannerKind; N]) -> [RunOutcome; N] {
+    std::thread::scope(|s| {
+        let handles: Vec<_> = kinds
+            .chunks(2)
+            .map(|pair| {
+                let pair = pair.to_vec();
+                s.spawn(move || {
+                    pair.into_iter()
+                        .map(|k| run(scenario, k))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        let all: Vec<RunOutcome> = handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap())
+            .collect();
+        all.try_into().unwrap_or_else(|_| unreachable!())
+    })
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -45,7 +55,21 @@ enum Perturbation {
     EgoSpeedMps(f64),
     ObstacleSpeedMps(f64),
     Mu(f64),
+    /// Obstacle 3 m further ahead, ego 1 m/s slower, obstacle 1 m/s faster.
+    WorstCorner,
 }
+
+const PERTURBATIONS: [Perturbation; 9] = [
+    Perturbation::Nominal,
+    Perturbation::ObstacleStartM(-3.0),
+    Perturbation::ObstacleStartM(3.0),
+    Perturbation::EgoSpeedMps(-1.0),
+    Perturbation::EgoSpeedMps(1.0),
+    Perturbation::ObstacleSpeedMps(-1.0),
+    Perturbation::ObstacleSpeedMps(1.0),
+    Perturbation::Mu(0.7),
+    Perturbation::Mu(0.9),
+];
 
 fn vehicle_mut<'a>(scenario: &'a mut Scenario, name: &str) -> &'a mut mergesim::sim::VehicleSpec {
     scenario
@@ -55,288 +79,324 @@ fn vehicle_mut<'a>(scenario: &'a mut Scenario, name: &str) -> &'a mut mergesim::
         .unwrap()
 }
 
-/// The built-in scenario with one perturbation (a speed change moves the initial and the
-/// target speed together, as the scenario's [randomise] table does).
-fn variant(p: Perturbation) -> Scenario {
-    let mut scenario = Scenario::load("urgent_merge").unwrap();
+fn shift_speed(scenario: &mut Scenario, name: &str, dv: f64) {
+    let v = vehicle_mut(scenario, name);
+    v.speed_mps += dv;
+    v.target_speed_mps += dv;
+}
+
+/// The built-in scenario with the parameter set and one perturbation (a speed change moves the
+/// initial and the target speed together, as the scenario's [randomise] table does).
+fn variant(set: ParameterSet, p: Perturbation) -> Scenario {
+    let mut scenario = Scenario::load("urgent_merge")
+        .unwrap()
+        .with_parameter_set(set)
+        .unwrap();
     match p {
         Perturbation::Nominal => {}
         Perturbation::ObstacleStartM(dx) => vehicle_mut(&mut scenario, OBSTACLE).x_m += dx,
-        Perturbation::EgoSpeedMps(dv) => {
-            let v = vehicle_mut(&mut scenario, EGO);
-            v.speed_mps += dv;
-            v.target_speed_mps += dv;
-        }
-        Perturbation::ObstacleSpeedMps(dv) => {
-            let v = vehicle_mut(&mut scenario, OBSTACLE);
-            v.speed_mps += dv;
-            v.target_speed_mps += dv;
-        }
+        Perturbation::EgoSpeedMps(dv) => shift_speed(&mut scenario, EGO, dv),
+        Perturbation::ObstacleSpeedMps(dv) => shift_speed(&mut scenario, OBSTACLE, dv),
         Perturbation::Mu(mu) => scenario.sim.mu = mu,
+        Perturbation::WorstCorner => {
+            vehicle_mut(&mut scenario, OBSTACLE).x_m += 3.0;
+            shift_speed(&mut scenario, EGO, -1.0);
+            shift_speed(&mut scenario, OBSTACLE, 1.0);
+        }
     }
     scenario
 }
 
-fn rows<'a>(outcome: &'a RunOutcome, vehicle: &'a str) -> impl Iterator<Item = &'a TimeSeriesRow> {
-    outcome
-        .time_series
-        .iter()
-        .filter(move |r| r.vehicle == vehicle)
+fn vehicle<'a>(outcome: &'a RunOutcome, name: &str) -> &'a VehicleMetricsSummary {
+    outcome.vehicles.iter().find(|v| v.id == name).unwrap()
 }
 
-fn min_speed_mps(outcome: &RunOutcome, vehicle: &str) -> f64 {
-    rows(outcome, vehicle)
-        .map(|r| r.speed_mps)
-        .fold(f64::INFINITY, f64::min)
+fn paper<'a>(outcome: &'a RunOutcome, name: &str) -> &'a PaperMetricsSummary {
+    vehicle(outcome, name).paper_metrics.as_ref().unwrap()
 }
-
-/// First time the vehicle is more than [`SLOWING_THRESHOLD_MPS`] below `target_mps`.
-fn slowing_onset_s(outcome: &RunOutcome, vehicle: &str, target_mps: f64) -> Option<f64> {
-    rows(outcome, vehicle)
-        .find(|r| r.speed_mps < target_mps - SLOWING_THRESHOLD_MPS)
-        .map(|r| r.t_s)
-}
-
-fn path_length_m(outcome: &RunOutcome, vehicle: &str) -> f64 {
-    let points: Vec<(f64, f64)> = rows(outcome, vehicle).map(|r| (r.x_m, r.y_m)).collect();
-    points
-        .windows(2)
-        .map(|w| ((w[1].0 - w[0].0).powi(2) + (w[1].1 - w[0].1).powi(2)).sqrt())
-        .sum()
-}
-
-/// Largest |value| of one motion state of one vehicle over the run.
-fn peak_abs(outcome: &RunOutcome, vehicle: &str, state: fn(&TimeSeriesRow) -> f64) -> f64 {
-    rows(outcome, vehicle)
-        .map(|r| state(r).abs())
-        .fold(0.0, f64::max)
-}
-
-/// Root mean square of the yaw rate over the run (rad/s).
-fn rms_yaw_rate_radps(outcome: &RunOutcome, vehicle: &str) -> f64 {
-    let (sum, n) = rows(outcome, vehicle).fold((0.0, 0usize), |(s, n), r| {
-        (s + r.yaw_rate_radps * r.yaw_rate_radps, n + 1)
-    });
-    (sum / n as f64).sqrt()
-}
-
-/// A named scalar measure of a run.
-type Measure = (&'static str, fn(&RunOutcome) -> f64);
-
-/// The obstacle's motion states the paper compares (Fig. 4): peak |β|, |ψ|, |r| and RMS r.
-const MOTION_STATES: [Measure; 4] = [
-    ("peak |sideslip|", |o| {
-        peak_abs(o, OBSTACLE, |r| r.sideslip_rad)
-    }),
-    ("peak |yaw|", |o| peak_abs(o, OBSTACLE, |r| r.yaw_rad)),
-    ("peak |yaw rate|", |o| {
-        peak_abs(o, OBSTACLE, |r| r.yaw_rate_radps)
-    }),
-    ("RMS yaw rate", |o| rms_yaw_rate_radps(o, OBSTACLE)),
-];
 
 fn collisions(outcome: &RunOutcome) -> usize {
     outcome.safety.collisions.len() + outcome.safety.edge_contacts.len()
 }
 
-/// Asserts every finding that holds, on one variant.
-fn check_findings(p: Perturbation) {
-    let scenario = variant(p);
+fn zone_rms(outcome: &RunOutcome, name: &str) -> f64 {
+    paper(outcome, name).merge_zone_rms_yaw_rate_radps.unwrap()
+}
+
+/// The obstacle's motion states of the paper's Fig. 4 (peak |β|, |ψ|, |r|) and the yaw-rate
+/// RMS in the merge zone.
+fn motion_states(outcome: &RunOutcome) -> [(&'static str, f64); 4] {
+    let o = vehicle(outcome, OBSTACLE);
+    [
+        ("peak |sideslip|", o.max_abs_sideslip_rad),
+        ("peak |yaw|", o.max_abs_yaw_rad),
+        ("peak |yaw rate|", o.max_abs_yaw_rate_radps),
+        (
+            "RMS yaw rate in the merge zone",
+            zone_rms(outcome, OBSTACLE),
+        ),
+    ]
+}
+
+/// The findings of the `mergesim` set on one variant; returns whether the obstacle made room.
+fn check_mergesim_findings(p: Perturbation) -> bool {
+    use PlannerKind::*;
+    let scenario = variant(ParameterSet::Mergesim, p);
     let road = scenario.sim.road.clone();
-    let ego = scenario
-        .vehicles
-        .iter()
-        .find(|v| v.name == EGO)
-        .unwrap()
-        .clone();
-    let obstacle_target_mps = scenario
-        .vehicles
-        .iter()
-        .find(|v| v.name == OBSTACLE)
-        .unwrap()
-        .target_speed_mps;
-    let [cs, sp, iso, pred] = run_all(&scenario);
-    let label = |kind: &str| format!("{p:?} {kind}");
+    let spec = |name: &str| scenario.vehicles.iter().find(|v| v.name == name).unwrap();
+    let (ego, obstacle) = (spec(EGO).clone(), spec(OBSTACLE).clone());
+    let [cs, sp, iso, pred] = run_kinds(&scenario, [PfCs, PfSp, PfIso, PfIsoPred]);
 
-    // No collision (vehicle–vehicle or road edge) with any planner, and the ego has merged.
-    for (kind, outcome) in [
-        ("pf-cs", &cs),
-        ("pf-sp", &sp),
-        ("pf-iso", &iso),
-        ("pf-iso-pred", &pred),
-    ] {
-        assert_eq!(
-            collisions(outcome),
-            0,
-            "{}: {:?}",
-            label(kind),
-            outcome.events
-        );
+    // No collision with any planner, and the ego has merged by the end.
+    for (kind, outcome) in [(PfCs, &cs), (PfSp, &sp), (PfIso, &iso), (PfIsoPred, &pred)] {
+        assert_eq!(collisions(outcome), 0, "{p:?} {kind}: {:?}", outcome.events);
+        let crossing = paper(outcome, EGO).divider_crossing;
         assert!(
-            outcome.safety.min_gap_m.is_some_and(|g| g > 0.0),
-            "{}",
-            label(kind)
-        );
-        let last = rows(outcome, EGO).last().unwrap();
-        assert!(
-            last.x_m > road.merge_end_x_m && last.y_m > road.y_lane_m(),
-            "{}: ego ended at ({}, {})",
-            label(kind),
-            last.x_m,
-            last.y_m
+            crossing.is_some_and(|c| c.x_m < road.merge_end_x_m),
+            "{p:?} {kind}: ego crossing {crossing:?}"
         );
     }
+    // PF-CS never brakes.
+    assert_eq!(paper(&cs, OBSTACLE).slowing_onset_s, None, "{p:?}");
 
-    // PF-ISO: the obstacle starts slowing early, before the ego has even reached the merge
-    // section (it is still in its own lane, so nothing but the shared path can tell the
-    // obstacle where the ego is going).
-    let ego_at_merge_s = (road.merge_start_x_m - ego.x_m) / ego.speed_mps;
-    let onset_s = slowing_onset_s(&iso, OBSTACLE, obstacle_target_mps);
-    assert!(
-        onset_s.is_some_and(|t| t < ego_at_merge_s),
-        "{}: slowing onset {onset_s:?}, ego reaches the merge section at {ego_at_merge_s:.2} s",
-        label("pf-iso")
-    );
-    // ... earlier than with constant-velocity predictions instead of the SLP (PF-ISO-PRED):
-    // what V2V adds beyond the interaction term.
-    let pred_onset_s = slowing_onset_s(&pred, OBSTACLE, obstacle_target_mps);
-    assert!(
-        pred_onset_s.is_none_or(|t| onset_s.is_some_and(|o| o < t)),
-        "{p:?}: PF-ISO onset {onset_s:?} vs PF-ISO-PRED {pred_onset_s:?}"
-    );
-    // ... then accelerates back to its target by the end of the run.
-    let last = rows(&iso, OBSTACLE).last().unwrap();
-    assert!(
-        (last.speed_mps - obstacle_target_mps).abs() < 0.3,
-        "{}: final speed {}",
-        label("pf-iso"),
-        last.speed_mps
-    );
-    // ... so its path over the run is the shortest of the three (pre-braking).
-    let iso_path_m = path_length_m(&iso, OBSTACLE);
-    for (kind, outcome) in [("pf-cs", &cs), ("pf-sp", &sp)] {
-        let other_m = path_length_m(outcome, OBSTACLE);
+    let iso_onset = paper(&iso, OBSTACLE).slowing_onset_s;
+    let makes_room =
+        vehicle(&iso, OBSTACLE).min_speed_mps < obstacle.target_speed_mps - MAKES_ROOM_MPS;
+    // Wherever PF-SP's obstacle brakes, PF-ISO's started slowing earlier.
+    if let Some(sp_onset) = paper(&sp, OBSTACLE).slowing_onset_s {
         assert!(
-            iso_path_m < other_m,
-            "{p:?}: obstacle path PF-ISO {iso_path_m:.2} m vs {kind} {other_m:.2} m"
+            iso_onset.is_some_and(|t| t < sp_onset),
+            "{p:?}: onset PF-ISO {iso_onset:?} vs PF-SP {sp_onset}"
         );
-        // PF-CS and PF-SP do not brake for the merging ego at all (see docs/reproduction.md:
-        // the paper's late braking of PF-SP is not reproduced).
-        assert!(min_speed_mps(outcome, OBSTACLE) > obstacle_target_mps - SLOWING_THRESHOLD_MPS);
     }
-    // PF-ISO: the obstacle's motion states stay the smallest of the three planners (paper
-    // Fig. 4): its peak sideslip, yaw and yaw rate, and its RMS yaw rate, are below those with
-    // PF-CS and PF-SP. (The paper also has PF-CS above PF-SP; here the two are equal to within
-    // 1 %, since our PF-SP never brakes: see docs/reproduction.md.)
-    for (state, value) in MOTION_STATES {
-        let iso_value = value(&iso);
-        for (kind, outcome) in [("pf-cs", &cs), ("pf-sp", &sp)] {
-            let other = value(outcome);
+    if iso_onset.is_some() {
+        // PF-ISO: the obstacle starts slowing before the ego has reached the merge section
+        // (still in its own lane: only its shared path says where it is going) ...
+        let ego_at_merge_s = (road.merge_start_x_m - ego.x_m) / ego.speed_mps;
+        assert!(
+            iso_onset.is_some_and(|t| t < ego_at_merge_s),
+            "{p:?}: onset {iso_onset:?}, ego at the merge section at {ego_at_merge_s:.2} s"
+        );
+        // ... accelerates back to its target by the end ...
+        let last = vehicle(&iso, OBSTACLE).final_speed_mps;
+        assert!(
+            (last - obstacle.target_speed_mps).abs() < 0.3,
+            "{p:?}: final speed {last}"
+        );
+        // ... has the shortest path of the three (pre-braking) and winds least in the merge
+        // zone, PF-SP between PF-ISO and PF-CS.
+        let iso_path = vehicle(&iso, OBSTACLE).path_length_m;
+        for (kind, outcome) in [(PfCs, &cs), (PfSp, &sp)] {
+            let other = vehicle(outcome, OBSTACLE).path_length_m;
             assert!(
-                iso_value < other,
-                "{p:?}: obstacle {state} PF-ISO {iso_value:.5} vs {kind} {other:.5}"
+                iso_path < other,
+                "{p:?}: path PF-ISO {iso_path} vs {kind} {other}"
+            );
+        }
+        let [i, s, c] = [&iso, &sp, &cs].map(|o| zone_rms(o, OBSTACLE));
+        assert!(i < s && s < c, "{p:?}: merge-zone RMS r {i} / {s} / {c}");
+    }
+    if makes_room {
+        // Where it has to give up more than 0.5 m/s, every motion state of the paper's Fig. 4
+        // is ordered PF-ISO < PF-SP < PF-CS.
+        for (k, (state, iso_value)) in motion_states(&iso).into_iter().enumerate() {
+            let sp_value = motion_states(&sp)[k].1;
+            let cs_value = motion_states(&cs)[k].1;
+            assert!(
+                iso_value < sp_value && sp_value < cs_value,
+                "{p:?}: obstacle {state}: PF-ISO {iso_value:.6}, PF-SP {sp_value:.6}, PF-CS {cs_value:.6}"
             );
         }
     }
-    // Not asserted: the ego's peak yaw rate lower with PF-ISO than with PF-CS. It is higher
-    // (nominal 0.0192 vs 0.0167 rad/s): with the obstacle further back, the ego changes lanes in
-    // one quicker manoeuvre. See docs/reproduction.md.
+    if iso_onset.is_none() {
+        // Nobody has to make room: every planner drives the obstacle alike (within 10 % of
+        // PF-CS's merge-zone yaw-rate RMS).
+        let reference = zone_rms(&cs, OBSTACLE);
+        for (kind, outcome) in [(PfSp, &sp), (PfIso, &iso), (PfIsoPred, &pred)] {
+            let value = zone_rms(outcome, OBSTACLE);
+            assert!(
+                (value - reference).abs() < 0.1 * reference,
+                "{p:?} {kind}: {value} vs PF-CS {reference}"
+            );
+        }
+    }
+    makes_room
 }
 
 #[test]
-fn nominal_urgent_merge_reproduces_the_findings_that_hold() {
-    check_findings(Perturbation::Nominal);
-    // On the nominal scenario the obstacle's slowing starts about when the paper's does
-    // (3.1 s): before 5 s, while the ego is still 60+ m short of the merge section.
-    let scenario = variant(Perturbation::Nominal);
-    let iso = run(&scenario, PlannerKind::PfIso);
-    let onset_s = slowing_onset_s(&iso, OBSTACLE, 15.0).unwrap();
-    assert!(onset_s < 5.0, "{onset_s}");
-    // It gives up at least 0.5 m/s (paper: 5.6 m/s; see docs/reproduction.md for why ours is
-    // smaller) and the ego never slows for it.
-    assert!(min_speed_mps(&iso, OBSTACLE) < 15.0 - 0.5);
-    assert!(min_speed_mps(&iso, EGO) > 20.0 - SLOWING_THRESHOLD_MPS);
-    // Its yaw rate stays "near zero" (paper): at most half of PF-CS's peak.
-    let cs = run(&scenario, PlannerKind::PfCs);
-    let peak_r = |o: &RunOutcome| peak_abs(o, OBSTACLE, |r| r.yaw_rate_radps);
+fn mergesim_set_nominal_and_perturbed_merges() {
+    let made_room = PERTURBATIONS
+        .into_iter()
+        .filter(|p| check_mergesim_findings(*p))
+        .count();
+    // The obstacle has to make room in most variants (6 of 9 measured): the branch above that
+    // asserts the paper's findings is not the rare one.
+    assert!(made_room >= 5, "{made_room}");
+}
+
+#[test]
+fn mergesim_set_nominal_magnitudes() {
+    let scenario = variant(ParameterSet::Mergesim, Perturbation::Nominal);
+    let [cs, iso] = run_kinds(&scenario, [PlannerKind::PfCs, PlannerKind::PfIso]);
+    // The obstacle starts slowing about when the paper's does (3.1 s).
+    let onset = paper(&iso, OBSTACLE).slowing_onset_s.unwrap();
+    assert!((2.0..4.5).contains(&onset), "{onset}");
+    // Its peak yaw rate is less than half of PF-CS's, and the ego never slows for it.
+    let peak = |o: &RunOutcome| vehicle(o, OBSTACLE).max_abs_yaw_rate_radps;
     assert!(
-        peak_r(&iso) < 0.5 * peak_r(&cs),
-        "obstacle peak |r|: PF-ISO {} vs PF-CS {}",
-        peak_r(&iso),
-        peak_r(&cs)
+        peak(&iso) < 0.5 * peak(&cs),
+        "{} vs {}",
+        peak(&iso),
+        peak(&cs)
     );
+    assert_eq!(paper(&iso, EGO).slowing_onset_s, None);
 }
 
+/// The worst corner of the perturbation box (the ego draws level only at the end of the
+/// taper): PF-CS and its control PF-SP-EQ10, which cannot brake, run into the obstacle; the
+/// planners that brake for risk (PF-SP) or interact (PF-ISO, PF-ISO-PRED) do not.
 #[test]
-fn findings_survive_a_different_initial_gap() {
-    check_findings(Perturbation::ObstacleStartM(-3.0));
-    check_findings(Perturbation::ObstacleStartM(3.0));
-}
-
-#[test]
-fn findings_survive_a_different_ego_speed() {
-    check_findings(Perturbation::EgoSpeedMps(-1.0));
-    check_findings(Perturbation::EgoSpeedMps(1.0));
-}
-
-#[test]
-fn findings_survive_a_different_obstacle_speed() {
-    check_findings(Perturbation::ObstacleSpeedMps(-1.0));
-    check_findings(Perturbation::ObstacleSpeedMps(1.0));
-}
-
-#[test]
-fn findings_survive_a_different_friction() {
-    check_findings(Perturbation::Mu(0.7));
-    check_findings(Perturbation::Mu(0.9));
-}
-
-/// The worst corner of the perturbation box (obstacle 3 m further ahead, ego 1 m/s slower,
-/// obstacle 1 m/s faster: the ego draws level only at x ≈ 240 m): PF-CS and PF-SP, which cannot
-/// yield, run into the obstacle; PF-ISO resolves it with the ego slowing and merging behind.
-#[test]
-fn in_the_worst_corner_only_the_interactive_planner_avoids_the_collision() {
-    let mut scenario = variant(Perturbation::ObstacleStartM(3.0));
-    let ego = vehicle_mut(&mut scenario, EGO);
-    ego.speed_mps -= 1.0;
-    ego.target_speed_mps -= 1.0;
-    let obstacle = vehicle_mut(&mut scenario, OBSTACLE);
-    obstacle.speed_mps += 1.0;
-    obstacle.target_speed_mps += 1.0;
-    let [cs, sp, iso, pred] = run_all(&scenario);
+fn mergesim_set_worst_corner_only_the_planners_that_can_brake_avoid_the_collision() {
+    use PlannerKind::*;
+    let scenario = variant(ParameterSet::Mergesim, Perturbation::WorstCorner);
+    let [cs, eq10, sp, iso, pred] = run_kinds(&scenario, [PfCs, PfSpEq10, PfSp, PfIso, PfIsoPred]);
     assert!(collisions(&cs) > 0);
-    assert!(collisions(&sp) > 0);
-    for outcome in [&iso, &pred] {
-        assert_eq!(collisions(outcome), 0, "{:?}", outcome.events);
-        // The ego yields: it ends up behind the obstacle.
-        let ego_last = rows(outcome, EGO).last().unwrap();
-        let obstacle_last = rows(outcome, OBSTACLE).last().unwrap();
-        assert!(ego_last.x_m < obstacle_last.x_m);
+    assert!(collisions(&eq10) > 0);
+    for (kind, outcome) in [(PfSp, &sp), (PfIso, &iso), (PfIsoPred, &pred)] {
+        assert_eq!(collisions(outcome), 0, "{kind}: {:?}", outcome.events);
     }
 }
 
-/// Where the two outcomes meet (obstacle start 45–53 m: up to 46 m the obstacle makes room,
-/// from 47 m the ego yields): with the shared paths PF-ISO switches between them without a
-/// collision; with constant-velocity predictions instead (PF-ISO-PRED, no V2V) the two vehicles
-/// misread each other's intent and race into each other at some starts (47.2–50.8 m measured;
-/// docs/reproduction.md, "Where the two equilibria meet").
+/// Where the two outcomes meet (obstacle start 45–53 m: first the obstacle makes room, then the
+/// ego yields): with roles fixed from the order now, neither PF-ISO nor PF-ISO-PRED collides
+/// (with per-slot roles on constant-velocity predictions PF-ISO-PRED raced into the obstacle at
+/// 47.2–50.8 m; docs/reproduction.md, "Where the two equilibria meet").
 #[test]
-fn at_the_switch_between_the_equilibria_only_shared_paths_avoid_the_collision() {
-    let mut pred_collisions = 0;
+fn mergesim_set_switch_between_the_equilibria_is_collision_free_with_and_without_v2v() {
     for start_m in 45..=53 {
-        let mut scenario = variant(Perturbation::Nominal);
+        let mut scenario = variant(ParameterSet::Mergesim, Perturbation::Nominal);
         vehicle_mut(&mut scenario, OBSTACLE).x_m = f64::from(start_m);
-        let (iso, pred) = std::thread::scope(|s| {
-            let pred = s.spawn(|| run(&scenario, PlannerKind::PfIsoPred));
-            (run(&scenario, PlannerKind::PfIso), pred.join().unwrap())
-        });
-        assert_eq!(
-            collisions(&iso),
-            0,
-            "PF-ISO, obstacle start {start_m} m: {:?}",
-            iso.events
-        );
-        pred_collisions += usize::from(collisions(&pred) > 0);
+        let [iso, pred] = run_kinds(&scenario, [PlannerKind::PfIso, PlannerKind::PfIsoPred]);
+        for (kind, outcome) in [("pf-iso", &iso), ("pf-iso-pred", &pred)] {
+            assert_eq!(
+                collisions(outcome),
+                0,
+                "{kind}, obstacle start {start_m} m: {:?}",
+                outcome.events
+            );
+        }
     }
-    assert!(pred_collisions > 0, "PF-ISO-PRED never collided");
+}
+
+/// The `paper` set (the paper's literal Eq. 4 and Eq. 7, D_min without a time gap) shows the
+/// paper's phenomenon: PF-CS's obstacle winds inside the merge zone.
+#[test]
+fn paper_set_pf_cs_obstacle_winds_in_the_merge_zone() {
+    let scenario = variant(ParameterSet::Paper, Perturbation::Nominal);
+    let cs = run(&scenario, PlannerKind::PfCs);
+    let m = paper(&cs, OBSTACLE);
+    let inside = m.merge_zone_rms_yaw_rate_radps.unwrap();
+    let outside = m.outside_merge_zone_rms_yaw_rate_radps.unwrap();
+    assert!(inside >= 5.0 * outside, "{inside} vs {outside}");
+    let peak = vehicle(&cs, OBSTACLE).max_abs_yaw_rate_radps;
+    assert!(peak >= 0.03, "{peak}");
+    assert_eq!(collisions(&cs), 0);
+}
+
+/// The `paper` set: PF-SP brakes late; PF-ISO starts slowing earlier. In this reading the
+/// vehicle PF-ISO slows is the ego, not the obstacle: with the printed D_min the planning
+/// vehicle is always the follower, so the interaction term only slows the faster vehicle
+/// (docs/reproduction.md).
+#[test]
+fn paper_set_pf_sp_brakes_later_than_pf_iso() {
+    let scenario = variant(ParameterSet::Paper, Perturbation::Nominal);
+    let [sp, iso] = run_kinds(&scenario, [PlannerKind::PfSp, PlannerKind::PfIso]);
+    let sp_onset = paper(&sp, OBSTACLE).slowing_onset_s.expect("PF-SP brakes");
+    let first = |o: &RunOutcome| {
+        [EGO, OBSTACLE]
+            .iter()
+            .filter_map(|v| paper(o, v).slowing_onset_s)
+            .fold(f64::INFINITY, f64::min)
+    };
+    assert!(first(&iso) < sp_onset, "{} vs {sp_onset}", first(&iso));
+    assert!(paper(&iso, EGO).slowing_onset_s.is_some());
+    assert_eq!(paper(&iso, OBSTACLE).slowing_onset_s, None);
+    for outcome in [&sp, &iso] {
+        assert_eq!(collisions(outcome), 0);
+    }
+}
+
+/// The paper's causal claim, without the optimiser: the obstacle on PF-CS paths (`paper` set)
+/// but at the speed profile the paper reports for PF-ISO (15 → 9.4 m/s) winds less than at its
+/// constant 15 m/s, in the nominal merge and with the gap or the ego's speed perturbed.
+#[test]
+fn paper_set_prescribed_pre_braking_calms_pf_cs_s_winding() {
+    let prebraking = Scenario::load(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/experiments/prebraking_paper_profile.toml"
+    ))
+    .unwrap()
+    .with_parameter_set(ParameterSet::Paper)
+    .unwrap();
+    for p in [
+        Perturbation::Nominal,
+        Perturbation::ObstacleStartM(-3.0),
+        Perturbation::ObstacleStartM(3.0),
+        Perturbation::EgoSpeedMps(-1.0),
+        Perturbation::EgoSpeedMps(1.0),
+    ] {
+        let constant = variant(ParameterSet::Paper, p);
+        let mut prescribed = constant.clone();
+        prescribed.vehicles[1].driver = prebraking.vehicles[1].driver.clone();
+        let [a, b] = std::thread::scope(|s| {
+            let b = s.spawn(|| run(&prescribed, PlannerKind::PfCs));
+            [run(&constant, PlannerKind::PfCs), b.join().unwrap()]
+        });
+        assert!(
+            vehicle(&b, OBSTACLE).min_speed_mps < 9.6,
+            "{p:?}: profile followed"
+        );
+        for (state, value) in [
+            (
+                "RMS yaw rate in the merge zone",
+                zone_rms as fn(&RunOutcome, &str) -> f64,
+            ),
+            ("peak |yaw rate|", |o, n| {
+                vehicle(o, n).max_abs_yaw_rate_radps
+            }),
+        ] {
+            let (at_constant, braking) = (value(&a, OBSTACLE), value(&b, OBSTACLE));
+            assert!(
+                braking < at_constant,
+                "{p:?}: obstacle {state} {braking} with pre-braking vs {at_constant}"
+            );
+        }
+        assert_eq!(collisions(&b), 0, "{p:?}: {:?}", b.events);
+    }
+}
+
+/// PF-CS and PF-SP do not use the interaction term's parameters: changing every one of them
+/// leaves their runs bit for bit identical (and PF-ISO's not).
+#[test]
+fn interaction_parameters_do_not_move_the_baselines() {
+    let base = variant(ParameterSet::Mergesim, Perturbation::Nominal);
+    let mut changed = base.clone();
+    let p = &mut changed.sim.planner;
+    p.interaction_time_gap_s = 1.0;
+    p.interaction_epsilon = 2e-3;
+    p.interaction_lateral_safety_m = 4.0;
+    p.interaction_fraction_at_min_distance = 0.2;
+    p.interaction_floor = 0.05;
+    p.interaction_weight = 30.0;
+    p.interaction_rear_only = false;
+    p.interaction_slows_only = true;
+    p.interaction_slp_reading = mergesim::planner::SlpReading::FixedWaypoints;
+    for kind in [PlannerKind::PfCs, PlannerKind::PfSp, PlannerKind::PfSpEq10] {
+        let a = common::simulate(&base, Some(kind), 0, true);
+        let b = common::simulate(&changed, Some(kind), 0, true);
+        assert_eq!(a.time_series, b.time_series, "{kind}");
+    }
+    let a = run(&base, PlannerKind::PfIso);
+    let b = run(&changed, PlannerKind::PfIso);
+    assert_ne!(a.vehicles, b.vehicles);
 }

@@ -10,7 +10,7 @@
 //! - a received SLP is the sender's declared intent: with `interaction_rear_only` the roles are
 //!   read per time slot from the shared positions (behind it I follow: its full rear D_min;
 //!   ahead of it it follows: its front shrunk to the contact distance);
-//! - a prediction is not an intent: with `interaction_roles_from_order_now` the roles are fixed
+//! - a prediction is not an intent: with `roles_from_order_now` the roles are fixed
 //!   from the order now for the whole horizon — a vehicle ahead keeps its full by-side D_min on
 //!   both sides (I follow it, and must leave it its gap if I pass and cut in), a vehicle behind
 //!   only its contact distance (it follows me and keeps the gap, whatever the prediction says).

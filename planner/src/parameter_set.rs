@@ -15,7 +15,7 @@
 //! | `max_substep_m`, `substep_max_turn_rad` | one step per waypoint | 1 m, adaptive | an 8 m step jumps the 1 m wide divider ridge and bounces off the edge's wall |
 //! | `interaction_slp_reading` | `fixed-waypoints` | `arc-length` | speed enters only through D_min(v): the term cannot tell where a slower car will be |
 //! | `interaction_time_gap_s` | 0 | 2 s | as the path field's |
-//! | `interaction_rear_only`, `interaction_roles_from_order_now` | false, false | true, true | who keeps the gap (the follower), decided once from the order now for predicted vehicles |
+//! | `interaction_rear_only`, `roles_from_order_now` | false, false | true, true | who keeps the gap (the follower), decided once from the order now for predicted vehicles |
 //! | `prediction` | `constant-velocity` | `lane-following` | a car 0.02 rad off the road axis is predicted a lane off after 160 m |
 //!
 //! Each row's cost is measured in `docs/reproduction.md`.
@@ -68,7 +68,7 @@ impl ParameterSet {
                 interaction_slp_reading: SlpReading::FixedWaypoints,
                 interaction_time_gap_s: 0.0,
                 interaction_rear_only: false,
-                interaction_roles_from_order_now: false,
+                roles_from_order_now: false,
                 prediction: PredictionModel::ConstantVelocity,
                 // U_SLP is "calculated like Eq. 4": the same ε, d_lat and f as the path field.
                 interaction_epsilon: PlannerParams::default().obstacle_epsilon,

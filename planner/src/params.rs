@@ -159,12 +159,13 @@ pub struct PlannerParams {
     /// D_min(v_i)) or `arc-length` (at the ego's position after i slots at the planned speeds,
     /// s_i = Δt Σ_{j ≤ i} v_j, against the other's SLP at the same time).
     pub interaction_slp_reading: SlpReading,
-    /// For a vehicle whose motion is *predicted* (no fresh shared path: PF-ISO-PRED, PF-SP,
+    /// Shared by every planner that predicts (not an interaction parameter). For a vehicle whose
+    /// motion is *predicted* (no fresh shared path: PF-ISO-PRED, PF-SP,
     /// PF-ISO's fallback), fix the roles from the order now: a vehicle behind counts only at
     /// the contact distance, one ahead with its full D_min on both sides, whatever the
     /// prediction says about who will lead. A received shared path is the sender's declared
     /// intent and keeps the per-slot roles of `interaction_rear_only`.
-    pub interaction_roles_from_order_now: bool,
+    pub roles_from_order_now: bool,
     /// In the interaction term, a vehicle behind the planning vehicle counts only within the
     /// contact distance (l + l_o)/2 ahead of it, while a vehicle ahead keeps its full
     /// speed-dependent D_min behind it: the follower is responsible for the gap (as in RSS),
@@ -284,7 +285,7 @@ impl Default for PlannerParams {
             interaction_lateral_safety_m: 3.5,
             interaction_fraction_at_min_distance: 0.1,
             interaction_slp_reading: SlpReading::ArcLength,
-            interaction_roles_from_order_now: true,
+            roles_from_order_now: true,
             interaction_rear_only: true,
             interaction_slows_only: false,
             trust_region_mps: 2.0,

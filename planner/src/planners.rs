@@ -375,7 +375,7 @@ impl PfPlanner {
             // Risk along its own path: the path field, roles from the order now.
             let rules = RoleRules {
                 rear_only: false,
-                from_order_now: params.interaction_roles_from_order_now,
+                from_order_now: params.roles_from_order_now,
             };
             Box::new(arc_length_term(
                 params,
@@ -389,7 +389,7 @@ impl PfPlanner {
         } else {
             let rules = RoleRules {
                 rear_only: params.interaction_rear_only,
-                from_order_now: params.interaction_roles_from_order_now,
+                from_order_now: params.roles_from_order_now,
             };
             match params.interaction_slp_reading {
                 SlpReading::ArcLength => Box::new(arc_length_term(

@@ -264,7 +264,7 @@ fn a_follower_does_not_push_the_leader_when_the_follower_is_responsible() {
     let mean_speed = |kind: PlannerKind, rear_only: bool, from_order_now: bool| {
         let params = PlannerParams {
             interaction_rear_only: rear_only,
-            interaction_roles_from_order_now: from_order_now,
+            roles_from_order_now: from_order_now,
             ..PlannerParams::default()
         };
         let plan = PfPlanner::new(kind, params, MergeRoad::default())
