@@ -7,7 +7,8 @@
 //! - sub-steps: the Eq. 7 step integrated in adaptive sub-steps of at most 1 m
 //!   (`max_substep_m` = 1, `substep_max_turn_rad` = 0.1) or in one gradient step per waypoint
 //!   (the paper's);
-//! - the path field's time gap τ (`obstacle_time_gap_s`): 0 (the paper's D_min), 1, 3 s;
+//! - the path field's time gap τ (`obstacle_time_gap_s`): 0 (the paper's D_min), 1, 2 (the
+//!   `mergesim` set's), 3 s;
 //! - the interaction term's time gap τ_I (`interaction_time_gap_s`): 1, 2, 3 s.
 //!
 //! Every cell runs every planner on the same instances (the nominal scenario, or `runs` drawn
@@ -104,7 +105,7 @@ impl Default for GridAxes {
         Self {
             predict_obstacles_in_path: vec![false, true],
             substeps: vec![false, true],
-            path_time_gap_s: vec![0.0, 1.0, 3.0],
+            path_time_gap_s: vec![0.0, 1.0, 2.0, 3.0],
             interaction_time_gap_s: vec![1.0, 2.0, 3.0],
         }
     }
@@ -285,6 +286,8 @@ pub struct PairedDifference {
     pub lower: u64,
     /// Collisions of the planner's runs in this cell.
     pub collisions: u64,
+    /// Collisions of the reference planner's runs in this cell.
+    pub reference_collisions: u64,
 }
 
 /// Runs of one (cell, planner) job.
@@ -516,11 +519,13 @@ impl GridOutcome {
                         }
                     }
                 }
-                let collisions = in_cell
-                    .iter()
-                    .filter(|r| &r.planner == planner)
-                    .map(|r| r.collisions.unwrap_or(0))
-                    .sum();
+                let collisions_of = |name: &String| {
+                    in_cell
+                        .iter()
+                        .filter(|r| &r.planner == name)
+                        .map(|r| r.collisions.unwrap_or(0))
+                        .sum()
+                };
                 out.push(PairedDifference {
                     cell,
                     planner: planner.clone(),
@@ -532,7 +537,8 @@ impl GridOutcome {
                     mean_difference: mean(&diffs),
                     standard_error: standard_error(&diffs),
                     lower,
-                    collisions,
+                    collisions: collisions_of(planner),
+                    reference_collisions: collisions_of(reference),
                 });
             }
         }
@@ -606,9 +612,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_default_grid_has_36_cells_and_counts_shared_runs_once() {
+    fn the_default_grid_has_48_cells_and_counts_shared_runs_once() {
         let axes = GridAxes::default();
-        assert_eq!(axes.cells().len(), 36);
+        assert_eq!(axes.cells().len(), 48);
         let plan = GridPlan {
             scenario: Scenario::load("urgent_merge").unwrap(),
             planners: vec![PlannerKind::PfCs, PlannerKind::PfIso],
@@ -617,8 +623,8 @@ mod tests {
             seed: 0,
             threads: None,
         };
-        // PF-CS: 12 cells (τ_I shared), PF-ISO: 36.
-        assert_eq!(job_count(&plan), 48);
+        // PF-CS: 16 cells (τ_I shared), PF-ISO: 48.
+        assert_eq!(job_count(&plan), 64);
     }
 
     #[test]

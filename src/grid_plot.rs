@@ -1,7 +1,8 @@
 //! The sensitivity grid as a figure: one heat map per compared planner, cells coloured by the
 //! ratio of its mean metric to the reference planner's (below 1: calmer than the reference).
 //! Rows: the four (prediction, sub-steps) combinations; columns: τ × τ_I. A cell whose runs
-//! collided is outlined in black and marked with the count.
+//! collided is outlined in black and marked with the compared planner's collision count, and
+//! the reference planner's below it ("ref ×n").
 
 use std::path::Path;
 
@@ -110,7 +111,8 @@ pub fn write_grid_png(
                     ))
                     .map_err(|e| e.to_string())?;
                     let collisions = d.map_or(0, |d| d.collisions);
-                    if collisions > 0 {
+                    let reference_collisions = d.map_or(0, |d| d.reference_collisions);
+                    if collisions > 0 || reference_collisions > 0 {
                         area.draw(&Rectangle::new(
                             [(x, y), (x + cell_w - 2, y + cell_h - 2)],
                             BLACK.stroke_width(3),
@@ -127,8 +129,16 @@ pub fn write_grid_png(
                     } else {
                         text
                     };
-                    area.draw(&Text::new(text, (x + 10, y + cell_h / 2 - 8), font(15)))
+                    area.draw(&Text::new(text, (x + 8, y + 6), font(15)))
                         .map_err(|e| e.to_string())?;
+                    if reference_collisions > 0 {
+                        area.draw(&Text::new(
+                            format!("ref ×{reference_collisions}"),
+                            (x + 8, y + cell_h - 20),
+                            font(12),
+                        ))
+                        .map_err(|e| e.to_string())?;
+                    }
                 }
             }
         }

@@ -135,7 +135,7 @@ pub struct PlannerParams {
     pub travel_time_weight: f64,
     /// w2, weight of the speed deviation Σ ½ (v_i − V_target)² (s²/m²).
     pub speed_deviation_weight: f64,
-    /// w3, weight of the interaction term Σ ln U_SLP^i (0 turns PF-ISO into PF-SP).
+    /// w3, weight of the interaction term Σ ln U_SLP^i (0 turns PF-ISO into PF-SP-EQ10).
     pub interaction_weight: f64,
     /// Floor of the interaction term, ln(floor + Σ U_OB) (same unit as A_obs). The term acts
     /// where the others' fields exceed it and fades below: with the default (0.02, a fifth of
@@ -229,21 +229,14 @@ impl Default for PlannerParams {
             edge_gain_m2: 0.01,
             edge_clamp_distance_m: 0.1,
             obstacle_amplitude: 1.0,
-            // Sharper lateral decay than ε = 0.002 (σ_y 0.87 m instead of 0.99 m): a vehicle one
-            // lane away (3.5 m) then adds only 3e-4 to the field, so two cars side by side in
-            // their own lanes barely touch each other's interaction term (Eq. 10). With 0.002 the
-            // tiny cross-lane term tipped the urgent merge into the ego yielding and the obstacle
-            // accelerating, well before either car had moved laterally (docs/reproduction.md).
+            // Criterion (docs/parameters.md): the largest value of the 1–2–5 series with which a
+            // vehicle alongside, centred in the adjacent lane, moves a path's lateral
+            // equilibrium by at most the 5 cm lane-centring tolerance (3.7 cm; 1e-3 gives 5.9).
             obstacle_epsilon: 5e-4,
             obstacle_lateral_safety_m: 3.5,
             obstacle_fraction_at_min_distance: 0.1,
-            // The 3-second following rule of driver manuals: the follower's D_min is
-            // (l + l_o)/2 + 3 s · v_f (+ the braking term), 49.5 m at 15 m/s. It sets how much
-            // room the obstacle opens for the merging ego in PF-ISO (it slows to ≈ 13.4 m/s;
-            // with 2.5 s ≈ 13.9 m/s, too little for the paper's ordering of the obstacle's yaw
-            // rate to survive the perturbations; with 3.5 s the six-car `dense_merge` spreads
-            // out so much that its last car is still in the merge section after 30 s).
-            // docs/reproduction.md, "Calibration".
+            // The two-second rule (UK Highway Code, rule 126): the follower's D_min is
+            // (l + l_o)/2 + 2 s · v_f (+ the braking term), 34.5 m at 15 m/s.
             obstacle_time_gap_s: 2.0,
             ego_mass_factor: 1.0,
             other_mass_factor: 1.0,
@@ -251,9 +244,9 @@ impl Default for PlannerParams {
             obstacle_min_distance_length: MinDistanceLength::BodyLength,
             obstacle_min_distance_by_side: true,
             waypoint_count: 20,
-            // N · Δt_plan = 8 s of shared local path (160 m at 20 m/s): at t ≈ 3 s the ego's
-            // SLP already reaches the merge section, which is what lets the obstacle start
-            // slowing then (paper: 3.1 s); with 5 s it could not react before t ≈ 6 s.
+            // N · Δt_plan = 8 s, the planning horizon of Baidu Apollo's EM planner (Fan et al.
+            // 2018: "at least 8 s or 200 m"); with N = 20, waypoints every 8 m at 20 m/s, half the
+            // tracker's look-ahead there.
             step_time_s: 0.4,
             min_step_m: 1.0,
             max_substep_m: 1.0,
@@ -271,16 +264,18 @@ impl Default for PlannerParams {
             min_speed_mps: 0.5,
             travel_time_weight: 1.0,
             speed_deviation_weight: 1.0,
-            // w3 / w2 = 15 with the floor below: the obstacle gives up ≈ 1.6 m/s to open the
-            // gap. More buys little depth (w3 = 25: 13.3 instead of 13.4 m/s) and from w3 = 30
-            // (29 holds) the non-convex term tips a perturbed merge (obstacle at 16 m/s) into
-            // the ego yielding instead (docs/reproduction.md).
+            // Twice the smallest weight with which the term alone keeps a follower behind a
+            // slower leader on a single lane (6.0; a stability margin of 2, the same criterion
+            // as `risk_weight`; docs/parameters.md, `planner/tests/calibration.rs`).
             interaction_weight: 12.0,
-            // The term acts out to U ≈ 0.02, about 1.3 D_min (exp(−q) = 0.02 ⇔ q = 3.9 against
-            // q = 2.3 at D_min for the default fraction 0.1): a little beyond the safety
-            // distance, still fading a lane away (see `obstacle_epsilon`).
+            // A fifth of the field's level at D_min (0.1): ln(ε_I + U) follows the paper's ln U
+            // inside the safety ellipse and fades beyond ≈ 1.3 D_min (exp(−q) = 0.02 ⇔ q = 3.9
+            // against q = 2.3 at D_min).
             interaction_floor: 0.02,
+            // The two-second rule, as the path field's.
             interaction_time_gap_s: 2.0,
+            // The largest value of the 1–2–5 series with which a vehicle in the adjacent lane,
+            // 1–30 m ahead, changes a planned speed by at most 0.1 m/s (0.09; 1e-3 gives 0.17).
             interaction_epsilon: 5e-4,
             interaction_lateral_safety_m: 3.5,
             interaction_fraction_at_min_distance: 0.1,
@@ -299,6 +294,8 @@ impl Default for PlannerParams {
             solver_tolerance: 1e-7,
             max_shared_path_age_s: 0.5,
             prediction: PredictionModel::LaneFollowing,
+            // Twice the smallest weight with which the risk term keeps a PF-SP follower behind
+            // a slower leader on a single lane (19.5; docs/parameters.md).
             risk_weight: 39.0,
             fallback_decel_mps2: 2.0,
         }

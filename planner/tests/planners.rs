@@ -481,3 +481,53 @@ fn ego_leaves_the_ending_lane_before_the_edge_closes_in() {
         );
     }
 }
+
+/// PF-SP, the paper's risk-aware baseline without V2V: it slows for a slower vehicle ahead in
+/// its lane (60 m ahead at 10 m/s, predicted along its lane), keeps its target speed when
+/// alone, and its risk term never pushes it above the target (a faster vehicle closing from
+/// behind does not make it speed up). (Much closer, the prediction would run the ego through
+/// the leader within the horizon, where a bounded field rewards passing through: README,
+/// "Limits".)
+#[test]
+fn pf_sp_brakes_for_risk_ahead_and_never_races() {
+    let road = MergeRoad {
+        merge_start_x_m: 0.0,
+        merge_end_x_m: 50.0,
+        start_x_m: -100.0,
+        ..MergeRoad::default()
+    };
+    let ego = state(100.0, 5.25, 0.0, 15.0);
+    let plan = |neighbours: &[Neighbour]| {
+        PfPlanner::new(PlannerKind::PfSp, PlannerParams::default(), road.clone())
+            .unwrap()
+            .plan(&request(ego, 15.0, neighbours, &[]))
+            .unwrap()
+    };
+    let first_speed = |p: &Plan| p.path[1].speed_mps;
+    let alone = plan(&[]);
+    assert!((first_speed(&alone) - 15.0).abs() < 0.1, "{}", first_speed(&alone));
+    let slow_ahead = [Neighbour {
+        id: 1,
+        state: state(160.0, 5.25, 0.0, 10.0),
+        shape: VehicleShape::default(),
+    }];
+    let braking = plan(&slow_ahead);
+    assert!(first_speed(&braking) < 14.5, "{:?} {:?}", braking.path.iter().map(|p| p.speed_mps).collect::<Vec<_>>(), braking.path.iter().map(|p| (p.x_m, p.y_m)).collect::<Vec<_>>());
+    // PF-SP-EQ10 (no risk term) would not brake.
+    let eq10 = PfPlanner::new(PlannerKind::PfSpEq10, PlannerParams::default(), road.clone())
+        .unwrap()
+        .plan(&request(ego, 15.0, &slow_ahead, &[]))
+        .unwrap();
+    assert!(first_speed(&eq10) > 14.9);
+    let fast_behind = [Neighbour {
+        id: 1,
+        state: state(85.0, 5.25, 0.0, 22.0),
+        shape: VehicleShape::default(),
+    }];
+    let chased = plan(&fast_behind);
+    assert!(
+        chased.path.iter().all(|p| p.speed_mps <= 15.0 + 1e-6),
+        "{:?}",
+        chased.path.iter().map(|p| p.speed_mps).collect::<Vec<_>>()
+    );
+}

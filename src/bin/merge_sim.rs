@@ -768,7 +768,7 @@ struct GridArgs {
           default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
     planners: Vec<PlannerKind>,
     /// Path-field time gaps τ (s), comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "0,1,3", value_parser = parse_gap)]
+    #[arg(long, value_delimiter = ',', default_value = "0,1,2,3", value_parser = parse_gap)]
     path_gaps: Vec<f64>,
     /// Interaction time gaps τ_I (s), comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1,2,3", value_parser = parse_gap)]
@@ -918,12 +918,14 @@ fn cmd_grid(args: &GridArgs) -> Result<(), Failure> {
         };
         for (p, z) in peak.iter().zip(&zone) {
             outln!(
-                "{:<22} {:<12} peak {:>5}  zone {:>5}  collisions {}",
+                "{:<22} {:<12} peak {:>5}  zone {:>5}  collisions {} ({} {})",
                 p.cell.label(),
                 p.planner,
                 ratio(p),
                 ratio(z),
-                p.collisions
+                p.collisions,
+                p.reference,
+                p.reference_collisions
             );
         }
         if outcome.axes.cells().len() == 1 {
