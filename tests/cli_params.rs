@@ -95,8 +95,8 @@ fn a_scenario_s_planner_values_apply_on_top_of_its_set() {
     assert_eq!(ours.sim.planner.obstacle_time_gap_s, 1.5);
     assert!(ours.sim.planner.predict_obstacles_in_path);
     // And the text written back reads back the same.
-    let again = mergesim::scenarios::Scenario::from_toml(&scenario.to_toml().unwrap(), "x")
-        .unwrap();
+    let again =
+        mergesim::scenarios::Scenario::from_toml(&scenario.to_toml().unwrap(), "x").unwrap();
     assert_eq!(again.sim.planner, scenario.sim.planner);
 }
 
@@ -124,7 +124,9 @@ fn the_prescribed_speed_driver_follows_its_profile_and_bad_profiles_exit_2() {
     let t_min = obstacle["t_min_speed_s"].as_f64().unwrap();
     assert!((min - 9.4).abs() < 0.3, "{min}");
     assert!((t_min - 14.9).abs() < 1.0, "{t_min}");
-    let onset = obstacle["paper_metrics"]["slowing_onset_s"].as_f64().unwrap();
+    let onset = obstacle["paper_metrics"]["slowing_onset_s"]
+        .as_f64()
+        .unwrap();
     assert!((3.1..4.0).contains(&onset), "{onset}");
 
     let bad = std::fs::read_to_string(scenario)
@@ -167,7 +169,11 @@ fn a_small_grid_writes_paired_rows_csv_and_figure() {
     assert_eq!(v["grid"]["rows"].as_array().unwrap().len(), 16);
     assert_eq!(v["paired_peak_yaw_rate"].as_array().unwrap().len(), 8);
     let text = std::fs::read_to_string(&csv).unwrap();
-    assert_eq!(text.lines().count(), 1 + 16 * 2, "one line per run and vehicle");
+    assert_eq!(
+        text.lines().count(),
+        1 + 16 * 2,
+        "one line per run and vehicle"
+    );
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[1..4], b"PNG");
     // Bad input: an unknown vehicle, before any run.

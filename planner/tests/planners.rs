@@ -505,19 +505,36 @@ fn pf_sp_brakes_for_risk_ahead_and_never_races() {
     };
     let first_speed = |p: &Plan| p.path[1].speed_mps;
     let alone = plan(&[]);
-    assert!((first_speed(&alone) - 15.0).abs() < 0.1, "{}", first_speed(&alone));
+    assert!(
+        (first_speed(&alone) - 15.0).abs() < 0.1,
+        "{}",
+        first_speed(&alone)
+    );
     let slow_ahead = [Neighbour {
         id: 1,
         state: state(160.0, 5.25, 0.0, 10.0),
         shape: VehicleShape::default(),
     }];
     let braking = plan(&slow_ahead);
-    assert!(first_speed(&braking) < 14.5, "{:?} {:?}", braking.path.iter().map(|p| p.speed_mps).collect::<Vec<_>>(), braking.path.iter().map(|p| (p.x_m, p.y_m)).collect::<Vec<_>>());
+    assert!(
+        first_speed(&braking) < 14.5,
+        "{:?} {:?}",
+        braking.path.iter().map(|p| p.speed_mps).collect::<Vec<_>>(),
+        braking
+            .path
+            .iter()
+            .map(|p| (p.x_m, p.y_m))
+            .collect::<Vec<_>>()
+    );
     // PF-SP-EQ10 (no risk term) would not brake.
-    let eq10 = PfPlanner::new(PlannerKind::PfSpEq10, PlannerParams::default(), road.clone())
-        .unwrap()
-        .plan(&request(ego, 15.0, &slow_ahead, &[]))
-        .unwrap();
+    let eq10 = PfPlanner::new(
+        PlannerKind::PfSpEq10,
+        PlannerParams::default(),
+        road.clone(),
+    )
+    .unwrap()
+    .plan(&request(ego, 15.0, &slow_ahead, &[]))
+    .unwrap();
     assert!(first_speed(&eq10) > 14.9);
     let fast_behind = [Neighbour {
         id: 1,

@@ -347,7 +347,7 @@ impl Scenario {
         toml::to_string(&table).map_err(|e| error(e.to_string()))
     }
 
-    /// The instance drawn with `seed` from the `[randomise]` ranges (DESIGN: "same scenario +
+    /// The instance drawn with `seed` from the `[randomise]` ranges ("same scenario +
     /// same seed ⇒ same run"). Deterministic; the instance has no randomisation left, so it is
     /// its own nominal scenario. For a scenario that passed [`Scenario::check`], every value of
     /// the instance is valid; otherwise `World::new` reports the bad value.

@@ -1,4 +1,4 @@
-//! Per-vehicle motion, comfort and oscillation metrics (DESIGN §6; the paper's Table / Figs.
+//! Per-vehicle motion, comfort and oscillation metrics (the paper's Table / Figs.
 //! 7–9 report peak sideslip, yaw and yaw rate, and the speed profile).
 //!
 //! [`VehicleMetrics`] is fed one [`MetricsSample`] per logged instant and keeps running figures,

@@ -1,4 +1,4 @@
-//! Exact safety checks between vehicle bodies and against the road edges (DESIGN §6), with
+//! Exact safety checks between vehicle bodies and against the road edges, with
 //! parry3d 0.31.
 //!
 //! What is measured, at every instant the world loop hands to [`SafetyMonitor::check`]:

@@ -1,5 +1,5 @@
 //! The V2V bus: shared local paths (SLP) broadcast by connected vehicles, delivered after a
-//! latency, possibly dropped, and ignored once stale (DESIGN §2 step 1).
+//! latency, possibly dropped, and ignored once stale (step 1 of the tick).
 //!
 //! The paper assumes ideal communication (no latency, no loss): that is the default.
 

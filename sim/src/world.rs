@@ -1,6 +1,6 @@
 //! The closed-loop simulation: one `World` owns the physics, the vehicles, their planners and
 //! trackers, the V2V bus, the safety monitor, the metrics and the recorder, and advances them in
-//! the fixed order of DESIGN §2:
+//! the fixed order of the tick (README, "Layout"):
 //!
 //! 1. V2V delivery → 2. planning (each vehicle at its own period, visited by id) and broadcast →
 //! 3. tracking → 4. tire and suspension forces, rapier step → 5. parry safety checks →
@@ -305,7 +305,7 @@ impl World {
         self.finish()
     }
 
-    /// Advances one physics step in the order of DESIGN §2.
+    /// Advances one physics step in the fixed order of the tick (module doc).
     pub fn step(&mut self) -> Result<(), SimError> {
         let t_s = self.time_s();
         // 1. V2V delivery.

@@ -11,7 +11,7 @@
 //!    lateral spring of rate K_y/σ instead of an infinitely stiff damper; a low-speed damper fades
 //!    in below `low_speed_fade_mps` (PAC2002's VXLOW idea) so a parked car does not ring.
 //! 3. **Tyre forces** F_x, F_y from the combined-slip Magic Formula ([`crate::tire`]).
-//! 4. **Wheel spin**, semi-implicit (DESIGN §3: explicit Euler chatters because the spin time
+//! 4. **Wheel spin**, semi-implicit (explicit Euler chatters because the spin time
 //!    constant J·v/(r²·K_x) is ~3 ms): with F_x linearised in ω,
 //!    F_x(ω⁺) ≈ F_x + (∂F_x/∂κ)(r/v_den)(ω⁺ − ω), J(ω⁺ − ω)/dt = T_drive − r·F_x(ω⁺) − T_brake
 //!    gives ω⁺ = ω + dt (T_drive − r F_x) / (J + dt r² ∂F_x/∂κ / v_den); the brake is a Coulomb
