@@ -175,11 +175,11 @@ pub fn fit_bounded_cubic(
     tolerance: f64,
 ) -> Result<([f64; 4], FitMethod), PlannerError> {
     if x.len() != y.len() || x.len() != w.len() || x.len() < 4 {
-        return Err(PlannerError::InvalidParameter {
-            name: "cubic_fit.points".into(),
-            value: x.len() as f64,
-            reason: "need at least 4 points with as many y and weights".into(),
-        });
+        return Err(PlannerError::invalid(
+            "cubic_fit.points",
+            x.len() as f64,
+            "need at least 4 points with as many y and weights",
+        ));
     }
     let (m, r) = normal_equations(x, y, w);
     if let Some(cholesky) = m.cholesky() {

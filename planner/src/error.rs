@@ -2,19 +2,14 @@
 
 use thiserror::Error;
 
+pub use mergesim_types::InvalidParameter;
+
 /// Everything that can go wrong in the planner. Never a panic.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum PlannerError {
     /// A parameter is out of its allowed range.
-    #[error("invalid parameter {name} = {value}: {reason}")]
-    InvalidParameter {
-        /// Dotted name of the parameter, e.g. `road.lane_width_m`.
-        name: String,
-        /// The offending value.
-        value: f64,
-        /// What the allowed range is.
-        reason: String,
-    },
+    #[error(transparent)]
+    InvalidParameter(#[from] InvalidParameter),
     /// A state or intermediate value is NaN or infinite.
     #[error("non-finite value in {what}")]
     NonFinite {
@@ -39,4 +34,19 @@ pub enum PlannerError {
         /// Clarabel's status, as text.
         status: String,
     },
+}
+
+impl PlannerError {
+    /// Shorthand for [`PlannerError::InvalidParameter`].
+    pub fn invalid(name: impl Into<String>, value: f64, reason: impl Into<String>) -> Self {
+        Self::InvalidParameter(InvalidParameter::new(name, value, reason))
+    }
+
+    /// The parameter it names, if it is about one.
+    pub fn invalid_parameter(&self) -> Option<&InvalidParameter> {
+        match self {
+            Self::InvalidParameter(p) => Some(p),
+            _ => None,
+        }
+    }
 }

@@ -303,11 +303,7 @@ impl Default for PlannerParams {
 }
 
 fn invalid(name: &str, value: f64, reason: &str) -> PlannerError {
-    PlannerError::InvalidParameter {
-        name: format!("planner.{name}"),
-        value,
-        reason: reason.into(),
-    }
+    PlannerError::invalid(format!("planner.{name}"), value, reason)
 }
 
 impl PlannerParams {

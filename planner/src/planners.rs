@@ -172,11 +172,11 @@ fn check_shape(shape: &VehicleShape, what: &str) -> Result<(), PlannerError> {
             return Err(non_finite(&format!("{what}.{name}")));
         }
         if value <= 0.0 {
-            return Err(PlannerError::InvalidParameter {
-                name: format!("{what}.{name}"),
+            return Err(PlannerError::invalid(
+                format!("{what}.{name}"),
                 value,
-                reason: "must be > 0".into(),
-            });
+                "must be > 0",
+            ));
         }
     }
     Ok(())
@@ -193,21 +193,17 @@ pub fn validate_request(req: &PlanRequest<'_>) -> Result<(), PlannerError> {
         return Err(non_finite("request.target_speed_mps"));
     }
     if req.target_speed_mps < 0.0 {
-        return Err(PlannerError::InvalidParameter {
-            name: "request.target_speed_mps".into(),
-            value: req.target_speed_mps,
-            reason: "must be >= 0".into(),
-        });
+        return Err(PlannerError::invalid(
+            "request.target_speed_mps",
+            req.target_speed_mps,
+            "must be >= 0",
+        ));
     }
     if !req.mu.is_finite() {
         return Err(non_finite("request.mu"));
     }
     if req.mu <= 0.0 {
-        return Err(PlannerError::InvalidParameter {
-            name: "request.mu".into(),
-            value: req.mu,
-            reason: "must be > 0".into(),
-        });
+        return Err(PlannerError::invalid("request.mu", req.mu, "must be > 0"));
     }
     for n in req.neighbours {
         check_state(&n.state, &format!("neighbour {}", n.id))?;

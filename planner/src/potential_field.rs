@@ -9,55 +9,7 @@ use crate::road::MergeRoad;
 use crate::road_field::RoadField;
 use crate::types::{Neighbour, VehicleId, VehicleShape, VehicleState};
 
-/// Largest grid accepted by [`PotentialField::grid`] (cells).
-pub const MAX_GRID_CELLS: usize = 16 * 1024 * 1024;
-
-/// A regular grid of cell centres: cell (row, col) is at
-/// (x_min + (col + ½)·cell, y_min + (row + ½)·cell); values are stored row after row.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GridSpec {
-    /// Left edge of the window (m).
-    pub x_min_m: f64,
-    /// Bottom edge of the window (m).
-    pub y_min_m: f64,
-    /// Cell size (m).
-    pub cell_m: f64,
-    /// Number of cells along X.
-    pub columns: usize,
-    /// Number of cells along Y.
-    pub rows: usize,
-}
-
-impl GridSpec {
-    /// Checks that the grid is finite, non-empty and not absurdly large.
-    pub fn validate(&self) -> Result<(), PlannerError> {
-        for (name, value) in [("x_min_m", self.x_min_m), ("y_min_m", self.y_min_m)] {
-            if !value.is_finite() {
-                return Err(PlannerError::InvalidParameter {
-                    name: format!("grid.{name}"),
-                    value,
-                    reason: "must be finite".into(),
-                });
-            }
-        }
-        if !(self.cell_m.is_finite() && self.cell_m > 0.0) {
-            return Err(PlannerError::InvalidParameter {
-                name: "grid.cell_m".into(),
-                value: self.cell_m,
-                reason: "must be finite and > 0".into(),
-            });
-        }
-        let cells = self.columns.saturating_mul(self.rows);
-        if cells == 0 || cells > MAX_GRID_CELLS {
-            return Err(PlannerError::InvalidParameter {
-                name: "grid.columns × grid.rows".into(),
-                value: cells as f64,
-                reason: format!("must lie in [1, {MAX_GRID_CELLS}]"),
-            });
-        }
-        Ok(())
-    }
-}
+pub use mergesim_types::{GridSpec, MAX_GRID_CELLS};
 
 /// The universal field seen by one planning vehicle at one planning instant.
 #[derive(Clone, Debug)]

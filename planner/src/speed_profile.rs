@@ -30,11 +30,8 @@ pub struct SpeedProfile {
 impl SpeedProfile {
     /// Checks the points; the error names the offending point (`what` prefixes the name).
     pub fn validate(&self, what: &str) -> Result<(), PlannerError> {
-        let bad = |name: String, value: f64, reason: &str| PlannerError::InvalidParameter {
-            name,
-            value,
-            reason: reason.into(),
-        };
+        let bad =
+            |name: String, value: f64, reason: &str| PlannerError::invalid(name, value, reason);
         if self.points.is_empty() || self.points.len() > MAX_PROFILE_POINTS {
             return Err(bad(
                 format!("{what}.speed_profile"),

@@ -407,7 +407,7 @@ fn non_finite_input_is_a_typed_error() {
     req.mu = -1.0;
     assert!(matches!(
         p.plan(&req),
-        Err(PlannerError::InvalidParameter { .. })
+        Err(PlannerError::InvalidParameter(_))
     ));
 }
 

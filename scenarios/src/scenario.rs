@@ -375,10 +375,7 @@ impl Scenario {
 
 /// The field a simulator error names, if any.
 fn sim_error_field(e: &SimError) -> Option<String> {
-    match e {
-        SimError::InvalidParameter { name, .. } => Some(name.clone()),
-        _ => None,
-    }
+    e.invalid_parameter().map(|p| p.name.clone())
 }
 
 /// `vehicles[NAME].key` → (`NAME`, `key`).
@@ -476,6 +473,35 @@ x_m = { uniform = [-3.0, 3.0] }
             "{err}"
         );
         assert!(err.contains(&format!("line {line}")), "{err}");
+    }
+
+    /// Every `[sim.*]` section's errors name the file, the line and the field (they used to
+    /// lose the line where the road's or the planner's error was flattened to text).
+    #[test]
+    fn errors_of_every_sim_section_carry_file_line_and_field() {
+        for (section, key, value) in [
+            ("road", "lane_width_m", "9.0"),
+            ("planner", "step_time_s", "-1.0"),
+            ("safety", "ttc_threshold_s", "nan"),
+            ("tracker", "lookahead_min_m", "nan"),
+            ("v2v", "drop_probability", "2.0"),
+        ] {
+            let text = format!("{}\n[sim.{section}]\n{key} = {value}\n", urgent());
+            let err = Scenario::from_toml(&text, "x.toml").unwrap_err();
+            let line = line_of_text(&text, &format!("{key} = {value}"));
+            let message = err.to_string();
+            assert!(
+                message.starts_with(&format!("x.toml, line {line}:")),
+                "[sim.{section}] {key}: {message}"
+            );
+            assert!(message.contains(key), "{message}");
+            match err {
+                ScenarioError::Invalid { field, .. } => {
+                    assert_eq!(field.as_deref(), Some(format!("{section}.{key}").as_str()))
+                }
+                other => panic!("{other:?}"),
+            }
+        }
     }
 
     #[test]

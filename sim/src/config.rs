@@ -4,7 +4,7 @@ use planner::{Lane, MergeRoad, PlannerKind, PlannerParams, SpeedProfile};
 use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
 
-use crate::error::SimError;
+use crate::error::{InvalidParameter, SimError};
 use crate::idm::IdmParams;
 use crate::safety::SafetyParams;
 use crate::v2v::V2vParams;
@@ -64,14 +64,10 @@ impl Default for SimConfig {
 impl SimConfig {
     /// Checks every field; the error names it and its value.
     pub fn validate(&self) -> Result<(), SimError> {
-        let bad = |name: &str, value: f64, reason: &str| SimError::InvalidParameter {
-            name: name.to_string(),
-            value,
-            reason: reason.to_string(),
+        let bad = |name: &str, value: f64, reason: &str| {
+            SimError::InvalidParameter(InvalidParameter::new(name, value, reason))
         };
-        self.road
-            .validate()
-            .map_err(|e| SimError::InvalidScenario(e.to_string()))?;
+        self.road.validate()?;
         if !(self.mu.is_finite() && self.mu > 0.0 && self.mu <= 2.0) {
             return Err(bad("mu", self.mu, "must lie in (0, 2]"));
         }
@@ -101,9 +97,9 @@ impl SimConfig {
         }
         self.v2v.validate()?;
         self.idm.validate()?;
-        self.planner
-            .validate()
-            .map_err(|e| SimError::InvalidScenario(e.to_string()))?;
+        self.safety.validate().map_err(SimError::from)?;
+        self.tracker.validate()?;
+        self.planner.validate()?;
         Ok(())
     }
 }
@@ -183,20 +179,7 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
         vehicles::VehicleParams::preset(&spec.preset)?;
         let field = |name: &str| format!("vehicles[{}].{name}", spec.name);
         if let Driver::Prescribed { speed_profile, .. } = &spec.driver {
-            speed_profile
-                .validate(&field("driver.prescribed"))
-                .map_err(|e| match e {
-                    planner::PlannerError::InvalidParameter {
-                        name,
-                        value,
-                        reason,
-                    } => SimError::InvalidParameter {
-                        name,
-                        value,
-                        reason,
-                    },
-                    other => SimError::InvalidScenario(other.to_string()),
-                })?;
+            speed_profile.validate(&field("driver.prescribed"))?;
         }
         let ranges = [
             ("x_m", spec.x_m, config.road.start_x_m, config.road.end_x_m),
@@ -206,11 +189,11 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
         ];
         for (name, value, lo, hi) in ranges {
             if !(value.is_finite() && value >= lo && value <= hi) {
-                return Err(SimError::InvalidParameter {
-                    name: field(name),
+                return Err(SimError::InvalidParameter(InvalidParameter::new(
+                    field(name),
                     value,
-                    reason: format!("must lie in [{lo}, {hi}]"),
-                });
+                    format!("must lie in [{lo}, {hi}]"),
+                )));
             }
         }
     }

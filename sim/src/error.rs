@@ -2,19 +2,14 @@
 
 use thiserror::Error;
 
+pub use mergesim_types::InvalidParameter;
+
 /// Everything that can stop a simulation. Never a panic.
 #[derive(Debug, Error)]
 pub enum SimError {
-    /// A parameter is out of range.
-    #[error("invalid parameter {name} = {value}: {reason}")]
-    InvalidParameter {
-        /// Dotted name, e.g. `v2v.drop_probability`.
-        name: String,
-        /// The offending value.
-        value: f64,
-        /// The allowed range.
-        reason: String,
-    },
+    /// A parameter is out of range (its dotted name, e.g. `v2v.drop_probability`, says which).
+    #[error(transparent)]
+    InvalidParameter(#[from] InvalidParameter),
     /// Something about the scenario's vehicles is inconsistent (duplicate ids, ...).
     #[error("invalid scenario: {0}")]
     InvalidScenario(String),
@@ -40,4 +35,43 @@ pub enum SimError {
     /// Writing an output failed.
     #[error("recording: {0}")]
     Recording(String),
+}
+
+impl SimError {
+    /// Shorthand for [`SimError::InvalidParameter`].
+    pub fn invalid(name: impl Into<String>, value: f64, reason: impl Into<String>) -> Self {
+        Self::InvalidParameter(InvalidParameter::new(name, value, reason))
+    }
+
+    /// The parameter it names, if it is about one (also inside a vehicle's or a planner's
+    /// error), so a scenario loader can point at the file's line.
+    pub fn invalid_parameter(&self) -> Option<&InvalidParameter> {
+        match self {
+            Self::InvalidParameter(p) => Some(p),
+            Self::Vehicle(e) => e.invalid_parameter(),
+            Self::Planner { source, .. } => source.invalid_parameter(),
+            _ => None,
+        }
+    }
+}
+
+impl From<planner::PlannerError> for SimError {
+    /// A planner's refusal of its parameters (`planner.*`, `road.*`) keeps the field's name;
+    /// anything else is an invalid scenario.
+    fn from(e: planner::PlannerError) -> Self {
+        match e {
+            planner::PlannerError::InvalidParameter(p) => Self::InvalidParameter(p),
+            other => Self::InvalidScenario(other.to_string()),
+        }
+    }
+}
+
+impl From<crate::safety::SafetyError> for SimError {
+    /// A safety parameter out of range keeps the field's name (`safety.*`).
+    fn from(e: crate::safety::SafetyError) -> Self {
+        match e {
+            crate::safety::SafetyError::InvalidParameter(p) => Self::InvalidParameter(p),
+            other => Self::InvalidScenario(other.to_string()),
+        }
+    }
 }

@@ -16,7 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::SimError;
+use crate::error::{InvalidParameter, SimError};
 
 /// IDM parameters. Defaults: the original paper's highway set (Treiber et al. 2000, Table I),
 /// except the desired speed, which is each vehicle's `target_speed_mps`.
@@ -80,11 +80,11 @@ impl IdmParams {
         ];
         for (name, value, lo, hi) in fields {
             if !(value.is_finite() && value >= lo && value <= hi) {
-                return Err(SimError::InvalidParameter {
-                    name: format!("idm.{name}"),
+                return Err(SimError::InvalidParameter(InvalidParameter::new(
+                    format!("idm.{name}"),
                     value,
-                    reason: format!("must lie in [{lo}, {hi}]"),
-                });
+                    format!("must lie in [{lo}, {hi}]"),
+                )));
             }
         }
         Ok(())

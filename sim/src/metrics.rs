@@ -13,6 +13,7 @@
 //! RMS values are √(∫ x² dt / duration); with a single sample (no duration) the RMS of the
 //! acceleration is its magnitude and the jerk figures are 0.
 
+use mergesim_types::InvalidParameter;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -46,20 +47,20 @@ impl MetricsParams {
     pub fn validate(&self) -> Result<(), MetricsError> {
         let thr = self.yaw_rate_sign_threshold_radps;
         if !(thr.is_finite() && thr >= 0.0) {
-            return Err(MetricsError::InvalidParameter {
-                name: "metrics.yaw_rate_sign_threshold_radps".into(),
-                value: thr,
-                reason: "must be finite and >= 0".into(),
-            });
+            return Err(MetricsError::InvalidParameter(InvalidParameter::new(
+                "metrics.yaw_rate_sign_threshold_radps",
+                thr,
+                "must be finite and >= 0",
+            )));
         }
         if let Some([x0, x1]) = self.oscillation_window_x_m
             && !(x0.is_finite() && x1.is_finite() && x1 > x0)
         {
-            return Err(MetricsError::InvalidParameter {
-                name: "metrics.oscillation_window_x_m".into(),
-                value: x1,
-                reason: format!("must be finite with end > start = {x0}"),
-            });
+            return Err(MetricsError::InvalidParameter(InvalidParameter::new(
+                "metrics.oscillation_window_x_m",
+                x1,
+                format!("must be finite with end > start = {x0}"),
+            )));
         }
         Ok(())
     }
@@ -69,15 +70,8 @@ impl MetricsParams {
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum MetricsError {
     /// A parameter is out of range.
-    #[error("invalid parameter {name} = {value}: {reason}")]
-    InvalidParameter {
-        /// Dotted name.
-        name: String,
-        /// The offending value.
-        value: f64,
-        /// The allowed range.
-        reason: String,
-    },
+    #[error(transparent)]
+    InvalidParameter(#[from] InvalidParameter),
     /// A sample field is NaN or infinite.
     #[error("non-finite sample field {field} = {value} at t = {t_s} s")]
     NonFinite {

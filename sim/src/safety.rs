@@ -42,6 +42,7 @@
 
 use std::collections::BTreeMap;
 
+use mergesim_types::InvalidParameter;
 use parry3d::math::{Pose, Vector};
 use parry3d::query::{self, ShapeCastOptions, ShapeCastStatus};
 use parry3d::shape::{Cuboid, Segment};
@@ -92,38 +93,38 @@ impl SafetyParams {
         ];
         for (name, value) in positive {
             if !(value.is_finite() && value > 0.0) {
-                return Err(SafetyError::InvalidParameter {
-                    name: format!("safety.{name}"),
+                return Err(SafetyError::InvalidParameter(InvalidParameter::new(
+                    format!("safety.{name}"),
                     value,
-                    reason: "must be finite and > 0".into(),
-                });
+                    "must be finite and > 0",
+                )));
             }
         }
         if !(self.contact_tolerance_m.is_finite()
             && (0.0..=0.1).contains(&self.contact_tolerance_m))
         {
-            return Err(SafetyError::InvalidParameter {
-                name: "safety.contact_tolerance_m".into(),
-                value: self.contact_tolerance_m,
-                reason: "must lie in [0, 0.1] m".into(),
-            });
+            return Err(SafetyError::InvalidParameter(InvalidParameter::new(
+                "safety.contact_tolerance_m",
+                self.contact_tolerance_m,
+                "must lie in [0, 0.1] m",
+            )));
         }
         if !(self.near_miss_gap_m.is_finite() && self.near_miss_gap_m >= 0.0) {
-            return Err(SafetyError::InvalidParameter {
-                name: "safety.near_miss_gap_m".into(),
-                value: self.near_miss_gap_m,
-                reason: "must be finite and >= 0".into(),
-            });
+            return Err(SafetyError::InvalidParameter(InvalidParameter::new(
+                "safety.near_miss_gap_m",
+                self.near_miss_gap_m,
+                "must be finite and >= 0",
+            )));
         }
         if self.ttc_horizon_s < self.ttc_threshold_s {
-            return Err(SafetyError::InvalidParameter {
-                name: "safety.ttc_horizon_s".into(),
-                value: self.ttc_horizon_s,
-                reason: format!(
+            return Err(SafetyError::InvalidParameter(InvalidParameter::new(
+                "safety.ttc_horizon_s",
+                self.ttc_horizon_s,
+                format!(
                     "must be >= safety.ttc_threshold_s = {}",
                     self.ttc_threshold_s
                 ),
-            });
+            )));
         }
         Ok(())
     }
@@ -133,15 +134,8 @@ impl SafetyParams {
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SafetyError {
     /// A parameter is out of range.
-    #[error("invalid parameter {name} = {value}: {reason}")]
-    InvalidParameter {
-        /// Dotted name, e.g. `safety.ttc_horizon_s`.
-        name: String,
-        /// The offending value.
-        value: f64,
-        /// The allowed range.
-        reason: String,
-    },
+    #[error(transparent)]
+    InvalidParameter(#[from] InvalidParameter),
     /// The road geometry is invalid.
     #[error("invalid road: {0}")]
     InvalidRoad(#[from] PlannerError),

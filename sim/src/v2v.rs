@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use planner::{SharedLocalPath, VehicleId};
 use serde::{Deserialize, Serialize};
 
-use crate::error::SimError;
+use crate::error::{InvalidParameter, SimError};
 use crate::rng::SplitMix64;
 
 /// Communication parameters.
@@ -43,11 +43,11 @@ impl V2vParams {
             if value.is_finite() && ok {
                 Ok(())
             } else {
-                Err(SimError::InvalidParameter {
-                    name: format!("v2v.{name}"),
+                Err(SimError::InvalidParameter(InvalidParameter::new(
+                    format!("v2v.{name}"),
                     value,
-                    reason: format!("must be finite and {range}"),
-                })
+                    format!("must be finite and {range}"),
+                )))
             }
         };
         check("latency_s", self.latency_s, self.latency_s >= 0.0, ">= 0")?;

@@ -208,8 +208,8 @@ impl World {
             config.v2v.clone(),
             crate::rng::SplitMix64::derive(options.seed, 1),
         )?;
-        let safety = SafetyMonitor::new(config.safety.clone(), &config.road)
-            .map_err(|e| SimError::InvalidScenario(e.to_string()))?;
+        let safety =
+            SafetyMonitor::new(config.safety.clone(), &config.road).map_err(SimError::from)?;
         let mut world = Self {
             steps_per_plan: steps_for(config.planner_period_s, config.dt_s),
             steps_per_log: steps_for(config.log_period_s, config.dt_s),

@@ -13,7 +13,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use planner::{Lane, MergeRoad, PathPoint};
+use mergesim_types::{Lane, MergeRoad, PathPoint};
 use vehicles::{PhysicsWorld, Tracker, TrackerParams, Vehicle, VehicleParams};
 
 const DT_S: f64 = 0.002;

@@ -2,19 +2,14 @@
 
 use thiserror::Error;
 
+pub use mergesim_types::InvalidParameter;
+
 /// Everything that can go wrong when building or driving a vehicle. Never a panic.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum VehicleError {
     /// A parameter or input is outside its allowed range (or not finite).
-    #[error("invalid parameter {name} = {value}: {reason}")]
-    InvalidParameter {
-        /// Dotted name of the parameter, e.g. `vehicle.mass_kg`.
-        name: String,
-        /// The offending value.
-        value: f64,
-        /// What the allowed range is.
-        reason: String,
-    },
+    #[error(transparent)]
+    InvalidParameter(#[from] InvalidParameter),
     /// A vehicle preset name that does not exist.
     #[error("unknown vehicle preset {name:?}; valid presets: {valid}")]
     UnknownPreset {
@@ -38,11 +33,15 @@ pub enum VehicleError {
 
 impl VehicleError {
     /// Shorthand for [`VehicleError::InvalidParameter`].
-    pub(crate) fn invalid(name: impl Into<String>, value: f64, reason: impl Into<String>) -> Self {
-        Self::InvalidParameter {
-            name: name.into(),
-            value,
-            reason: reason.into(),
+    pub fn invalid(name: impl Into<String>, value: f64, reason: impl Into<String>) -> Self {
+        Self::InvalidParameter(InvalidParameter::new(name, value, reason))
+    }
+
+    /// The parameter it names, if it is about one.
+    pub fn invalid_parameter(&self) -> Option<&InvalidParameter> {
+        match self {
+            Self::InvalidParameter(p) => Some(p),
+            _ => None,
         }
     }
 }

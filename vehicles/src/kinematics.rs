@@ -44,8 +44,8 @@ pub struct Kinematics {
 
 impl Kinematics {
     /// The planner's view of this state.
-    pub fn to_vehicle_state(&self) -> planner::VehicleState {
-        planner::VehicleState {
+    pub fn to_vehicle_state(&self) -> mergesim_types::VehicleState {
+        mergesim_types::VehicleState {
             x_m: self.x_m,
             y_m: self.y_m,
             yaw_rad: self.yaw_rad,

@@ -119,14 +119,14 @@ impl PhysicsWorld {
     /// Adds the merge road: surface plus edge barriers along the upper edge and along each
     /// piece of the piecewise lower edge (`road.lower_edge_polyline()`), with default
     /// [`RoadColliderParams`]. Never panics: degenerate pieces are skipped.
-    pub fn add_merge_road(&mut self, road: &planner::MergeRoad) -> RoadColliders {
+    pub fn add_merge_road(&mut self, road: &mergesim_types::MergeRoad) -> RoadColliders {
         self.add_merge_road_with(road, &RoadColliderParams::default())
     }
 
     /// [`add_merge_road`](Self::add_merge_road) with explicit barrier / surface dimensions.
     pub fn add_merge_road_with(
         &mut self,
-        road: &planner::MergeRoad,
+        road: &mergesim_types::MergeRoad,
         params: &RoadColliderParams,
     ) -> RoadColliders {
         let colliders = build_merge_road(&mut self.world, road, params);

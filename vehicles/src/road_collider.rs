@@ -1,6 +1,6 @@
 //! Colliders of the merge road: a flat surface and thin walls along the road edges.
 //!
-//! Built from [`planner::MergeRoad`], the same description the planner's road field uses, so the
+//! Built from [`mergesim_types::MergeRoad`], the same description the planner's road field uses, so the
 //! physical edges and the potential-field edges (paper Eq. 3) coincide. The lower edge is
 //! exactly piecewise linear (`lower_edge_polyline()`: straight, linear taper, straight), so one
 //! wall per polyline piece reproduces it without approximation.
@@ -124,7 +124,7 @@ fn sane_params(p: &RoadColliderParams) -> RoadColliderParams {
 /// Inserts the road's colliders into `world` (standalone fixed colliders).
 pub(crate) fn build_merge_road(
     world: &mut RapierWorld,
-    road: &planner::MergeRoad,
+    road: &mergesim_types::MergeRoad,
     params: &RoadColliderParams,
 ) -> RoadColliders {
     let p = sane_params(params);
@@ -192,12 +192,12 @@ mod tests {
 
     #[test]
     fn walls_follow_the_piecewise_lower_edge_and_the_upper_edge() {
-        let road = planner::MergeRoad::default();
+        let road = mergesim_types::MergeRoad::default();
         let mut world = PhysicsWorld::new(0.002).unwrap();
         let colliders = world.add_merge_road(&road);
         assert_eq!(colliders.lower_edge.len(), 3);
         assert!(colliders.upper_edge.is_some());
-        let y_mid = road.lane_center_y_m(planner::Lane::Upper);
+        let y_mid = road.lane_center_y_m(mergesim_types::Lane::Upper);
         for x in [0.0, 150.0, 170.0, 210.0, 255.0, 300.0, 600.0] {
             let lower = wall_y(&world, x, y_mid, -1.0).unwrap();
             // Closed form of the lower edge (Eq. 3 read as Y = k_sl·X + b in the taper).
@@ -212,10 +212,10 @@ mod tests {
 
     #[test]
     fn degenerate_road_does_not_panic() {
-        let road = planner::MergeRoad {
+        let road = mergesim_types::MergeRoad {
             lane_width_m: f64::NAN,
             end_x_m: f64::INFINITY,
-            ..planner::MergeRoad::default()
+            ..mergesim_types::MergeRoad::default()
         };
         let mut world = PhysicsWorld::new(0.002).unwrap();
         let _ = world.add_merge_road(&road);

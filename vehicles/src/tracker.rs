@@ -310,7 +310,7 @@ pub struct Tracker {
 
 /// Projection of a point on a polyline: segment index, parameter along it (clamped to [0, 1]
 /// except before the first and after the last point), squared distance.
-fn project(path: &[planner::PathPoint], x: f64, y: f64) -> (usize, f64, f64) {
+fn project(path: &[mergesim_types::PathPoint], x: f64, y: f64) -> (usize, f64, f64) {
     let mut best = (0, 0.0, f64::INFINITY);
     let last = path.len().saturating_sub(2);
     for i in 0..path.len().saturating_sub(1) {
@@ -336,7 +336,7 @@ fn project(path: &[planner::PathPoint], x: f64, y: f64) -> (usize, f64, f64) {
 
 /// The point `distance_m` further along the path from (segment, t); beyond the last point the
 /// last segment is extended.
-fn walk(path: &[planner::PathPoint], segment: usize, t: f64, distance_m: f64) -> [f64; 2] {
+fn walk(path: &[mergesim_types::PathPoint], segment: usize, t: f64, distance_m: f64) -> [f64; 2] {
     let mut remaining = distance_m;
     let mut i = segment;
     let mut t = t;
@@ -401,7 +401,12 @@ impl Tracker {
 
     /// Controls following `path` from state `kin`. With fewer than two usable path points (or a
     /// non-finite state) the car keeps its steering and brakes to a stop.
-    pub fn update(&mut self, kin: &Kinematics, path: &[planner::PathPoint], dt_s: f64) -> Controls {
+    pub fn update(
+        &mut self,
+        kin: &Kinematics,
+        path: &[mergesim_types::PathPoint],
+        dt_s: f64,
+    ) -> Controls {
         let finite_state = [kin.x_m, kin.y_m, kin.yaw_rad, kin.speed_mps]
             .iter()
             .all(|v| v.is_finite());
@@ -473,8 +478,8 @@ impl Tracker {
 mod tests {
     use super::*;
 
-    fn point(x: f64, y: f64, v: f64) -> planner::PathPoint {
-        planner::PathPoint {
+    fn point(x: f64, y: f64, v: f64) -> mergesim_types::PathPoint {
+        mergesim_types::PathPoint {
             x_m: x,
             y_m: y,
             speed_mps: v,

@@ -250,8 +250,8 @@ impl Vehicle {
     }
 
     /// The planner's footprint of this car.
-    pub fn shape(&self, max_brake_decel_mps2: f64) -> planner::VehicleShape {
-        planner::VehicleShape {
+    pub fn shape(&self, max_brake_decel_mps2: f64) -> mergesim_types::VehicleShape {
+        mergesim_types::VehicleShape {
             length_m: self.params.length_m,
             width_m: self.params.width_m,
             wheelbase_m: self.params.wheelbase_m(),

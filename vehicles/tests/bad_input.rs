@@ -1,6 +1,6 @@
 //! Bad input gives errors naming the value, never a panic.
 
-use planner::PathPoint;
+use mergesim_types::PathPoint;
 use vehicles::{
     Controls, Kinematics, ManeuverConfig, ManeuverKind, PhysicsWorld, Tracker, TrackerParams,
     Vehicle, VehicleParams, run_maneuver,

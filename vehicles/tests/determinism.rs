@@ -1,6 +1,6 @@
 //! Bitwise determinism: identical runs give identical trajectories.
 
-use planner::{Lane, MergeRoad, PathPoint};
+use mergesim_types::{Lane, MergeRoad, PathPoint};
 use vehicles::{
     ManeuverConfig, ManeuverKind, PhysicsWorld, Tracker, TrackerParams, Vehicle, VehicleParams,
     run_maneuver,

@@ -1,6 +1,6 @@
 //! Spawning settled on the springs, statics, and physical contact with barriers and cars.
 
-use planner::{Lane, MergeRoad};
+use mergesim_types::{Lane, MergeRoad};
 use vehicles::{Controls, GRAVITY_MPS2, PhysicsWorld, Vehicle, VehicleParams, collision_groups};
 
 fn step(world: &mut PhysicsWorld, vehicles: &mut [&mut Vehicle], mu: f64) {

@@ -1,6 +1,6 @@
 //! The tracker follows a straight road with a lane change and holds a speed profile.
 
-use planner::PathPoint;
+use mergesim_types::PathPoint;
 use vehicles::{PhysicsWorld, Tracker, TrackerParams, Vehicle, VehicleParams};
 
 const LANE_WIDTH_M: f64 = 3.5;

@@ -96,20 +96,20 @@ impl SpeedOptimiser {
     ) -> Result<SpeedSolution, PlannerError> {
         let n = problem.segment_lengths_m.len();
         if n == 0 || problem.max_speeds_mps.len() != n {
-            return Err(PlannerError::InvalidParameter {
-                name: "speed_optimisation.max_speeds_mps".into(),
-                value: problem.max_speeds_mps.len() as f64,
-                reason: format!("need one bound per segment ({n} segments, at least one)"),
-            });
+            return Err(PlannerError::invalid(
+                "speed_optimisation.max_speeds_mps",
+                problem.max_speeds_mps.len() as f64,
+                format!("need one bound per segment ({n} segments, at least one)"),
+            ));
         }
         if let Some(term) = problem.interaction
             && term.slots() != n
         {
-            return Err(PlannerError::InvalidParameter {
-                name: "speed_optimisation.interaction".into(),
-                value: term.slots() as f64,
-                reason: format!("need one time slot per segment ({n})"),
-            });
+            return Err(PlannerError::invalid(
+                "speed_optimisation.interaction",
+                term.slots() as f64,
+                format!("need one time slot per segment ({n})"),
+            ));
         }
         let scalars = [problem.current_speed_mps, problem.target_speed_mps];
         if scalars

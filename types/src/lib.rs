@@ -1,0 +1,19 @@
+//! Plain data shared by mergesim's crates: the merge road's geometry, a vehicle's state and
+//! shape, path points and the shared local paths exchanged over V2V, a sampling grid, and the one
+//! typed error for a parameter out of range.
+//!
+//! No physics, no optimiser, no logging: the planner, the vehicle model and the simulator all
+//! speak these types, and depend on nothing else to do so.
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod grid;
+pub mod path;
+pub mod road;
+pub mod vehicle;
+
+pub use error::InvalidParameter;
+pub use grid::{GridSpec, MAX_GRID_CELLS};
+pub use path::{PathPoint, SharedLocalPath, TimedWaypoint};
+pub use road::{Lane, MergeRoad};
+pub use vehicle::{Neighbour, VehicleId, VehicleShape, VehicleState};
