@@ -3,9 +3,8 @@
 //! `cargo bench --bench urgent_merge`
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use mergesim::experiment::{InstanceOptions, run_quietly};
 use mergesim::scenarios::Scenario;
-use mergesim::sim::recording::Recorder;
-use mergesim::sim::{RunOptions, World};
 
 fn urgent_merge(c: &mut Criterion) {
     let scenario = match Scenario::load("urgent_merge") {
@@ -15,18 +14,12 @@ fn urgent_merge(c: &mut Criterion) {
     let mut group = c.benchmark_group("closed_loop");
     group.sample_size(10);
     group.bench_function("urgent_merge_25s_pf_iso", |b| {
-        b.iter(|| {
-            let world = World::new(
-                scenario.sim.clone(),
-                &scenario.vehicles,
-                &RunOptions::default(),
-                Recorder::disabled(),
-            );
-            match world.and_then(|w| w.run(|_| {})) {
-                Ok(outcome) => outcome,
+        b.iter(
+            || match run_quietly(&scenario, &InstanceOptions::default()) {
+                Ok(finished) => finished.outcome,
                 Err(e) => panic!("run failed: {e}"),
-            }
-        })
+            },
+        )
     });
     group.finish();
 }

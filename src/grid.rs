@@ -23,8 +23,8 @@ use planner::{PlannerKind, PlannerParams};
 use rayon::prelude::*;
 use scenarios::Scenario;
 use serde::{Deserialize, Serialize};
-use sim::recording::Recorder;
-use sim::{RunOptions, World};
+
+use crate::experiment::{InstanceOptions, run_quietly};
 
 use crate::sweep::instance_seed;
 
@@ -321,21 +321,14 @@ fn figures(outcome: &sim::RunOutcome) -> Vec<VehicleFigures> {
 }
 
 fn run_job(scenario: &Scenario, job: &Job) -> GridRow {
-    let instance = scenario.instance(job.seed);
-    let mut sim_config = instance.sim.clone();
-    sim_config.planner = job.cell.apply(&sim_config.planner);
-    let options = RunOptions {
-        planner_override: Some(job.planner),
-        seed: job.seed.unwrap_or(0),
+    let mut cell_scenario = scenario.clone();
+    cell_scenario.sim.planner = job.cell.apply(&scenario.sim.planner);
+    let options = InstanceOptions {
+        planner: Some(job.planner.name().to_string()),
+        seed: job.seed,
         keep_time_series: false,
     };
-    let result = World::new(
-        sim_config,
-        &instance.vehicles,
-        &options,
-        Recorder::disabled(),
-    )
-    .and_then(|world| world.run(|_| {}));
+    let result = run_quietly(&cell_scenario, &options).map(|finished| finished.outcome);
     let (collisions, error, vehicles) = match result {
         Ok(outcome) => (
             Some((outcome.safety.collisions.len() + outcome.safety.edge_contacts.len()) as u64),

@@ -5,10 +5,12 @@
 //! optimisation), [`vehicles`] (Rapier vehicles and tracker), [`sim`] (the closed loop) and
 //! [`scenarios`] (scenario files).
 
+pub mod experiment;
 pub mod grid;
 pub mod grid_plot;
 pub mod output;
 pub mod plots;
+pub mod report;
 pub mod summary;
 pub mod sweep;
 

@@ -25,9 +25,8 @@ use rayon::prelude::*;
 use scenarios::Scenario;
 use scenarios::randomisation::fnv1a64;
 use serde::{Deserialize, Serialize};
-use sim::recording::Recorder;
 use sim::rng::SplitMix64;
-use sim::{RunOptions, World};
+
 use thiserror::Error;
 
 use crate::summary::RunSummary;
@@ -418,54 +417,23 @@ pub struct SweepOutcome {
     pub run_wall_times_s: Vec<f64>,
 }
 
-/// The planner name of a sweep: the override, or the scenario's single kind, or `mixed`.
+/// The planner name of a sweep: the override, or the scenario's single planner, or `mixed`.
 pub fn planner_label(scenario: &Scenario, planner: Option<PlannerKind>) -> String {
-    if let Some(kind) = planner {
-        return kind.name().to_string();
-    }
-    let mut kinds: Vec<&str> = scenario
-        .vehicles
-        .iter()
-        .filter_map(|v| match &v.driver {
-            sim::Driver::Planner(kind) => Some(kind.name()),
-            // Lane keeping (and any other non-planner driver, e.g. a future IDM).
-            _ => None,
-        })
-        .collect();
-    kinds.sort_unstable();
-    kinds.dedup();
-    match kinds.as_slice() {
-        [] => "none".into(),
-        [one] => (*one).to_string(),
-        _ => "mixed".into(),
-    }
+    crate::experiment::planner_label(scenario, planner.map(|k| k.name()))
 }
 
 /// Runs instance `seed` of the plan's scenario: what `merge_sim run --seed <seed>` runs.
 pub fn simulate_instance(plan: &SweepPlan, seed: u64) -> Result<RunSummary, sim::SimError> {
-    let instance = plan.scenario.instantiate(seed);
-    let options = RunOptions {
-        planner_override: plan.planner,
-        seed,
+    let options = crate::experiment::InstanceOptions {
+        planner: plan.planner.map(|k| k.name().to_string()),
+        seed: Some(seed),
         keep_time_series: false,
     };
-    let started = Instant::now();
-    let world = World::new(
-        instance.sim,
-        &instance.vehicles,
-        &options,
-        Recorder::disabled(),
-    )?;
-    let outcome = world.run(|_| {})?;
-    let label = planner_label(&plan.scenario, plan.planner);
-    Ok(RunSummary::new(
-        &plan.scenario.name,
-        plan.scenario.params,
-        &label,
-        Some(seed),
-        started.elapsed().as_secs_f64(),
-        &outcome,
-    ))
+    crate::experiment::run_quietly(&plan.scenario, &options)
+        .map(|finished| finished.summary)
+        .map_err(|e| match e {
+            crate::experiment::RunError::Setup(e) | crate::experiment::RunError::Run(e) => e,
+        })
 }
 
 /// Runs the plan's shard with the simulator; `on_run_done` is called after each run (from the

@@ -6,6 +6,7 @@
 //! lists every reading of a typo or unit problem.
 
 pub mod attractive_field;
+pub mod behaviour;
 pub mod cubic_fit;
 pub mod error;
 pub mod fallback;
@@ -25,6 +26,7 @@ pub mod speed_profile;
 pub mod types;
 
 pub use error::PlannerError;
+pub use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
 pub use parameter_set::ParameterSet;
 pub use params::{PlannerParams, SlpReading};
 pub use planners::{PfPlanner, PlanRequest, PlanStats, PlannerKind};

@@ -6,7 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::PlannerError;
-use crate::types::{Plan, TimedWaypoint};
+use crate::types::{PathPoint, Plan, TimedWaypoint};
 
 /// Slowest speed a profile may prescribe (m/s): the speed optimiser's own v_min, so every
 /// segment has a finite travel time.
@@ -80,25 +80,31 @@ impl SpeedProfile {
     }
 }
 
+/// Re-times `path` (its first point's time kept) to `profile`: segment k (point k to point
+/// k + 1) is driven at the profile's speed at the time the path reaches point k, and the times
+/// follow, t_{k+1} = t_k + Δs_k / v_k.
+pub fn retime_path(path: &mut [PathPoint], profile: &SpeedProfile) {
+    let n = path.len();
+    for k in 0..n {
+        let t_s = path[k].t_s;
+        let v_mps = profile
+            .speed_at(t_s)
+            .clamp(MIN_PROFILE_SPEED_MPS, MAX_PROFILE_SPEED_MPS);
+        path[k].speed_mps = v_mps;
+        if k + 1 < n {
+            let (a, b) = (path[k], path[k + 1]);
+            let ds_m = (b.x_m - a.x_m).hypot(b.y_m - a.y_m);
+            path[k + 1].t_s = t_s + ds_m / v_mps;
+        }
+    }
+}
+
 impl Plan {
-    /// The same path with the speeds of `profile`: segment k (point k to point k + 1) is driven
-    /// at the profile's speed at the time the plan reaches point k, and the times follow,
-    /// t_{k+1} = t_k + Δs_k / v_k. The shared path gets the same times.
+    /// The same path with the speeds of `profile` ([`retime_path`]); the shared path gets the
+    /// same times.
     pub fn with_speed_profile(&self, profile: &SpeedProfile) -> Plan {
         let mut plan = self.clone();
-        let n = plan.path.len();
-        for k in 0..n {
-            let t_s = plan.path[k].t_s;
-            let v_mps = profile
-                .speed_at(t_s)
-                .clamp(MIN_PROFILE_SPEED_MPS, MAX_PROFILE_SPEED_MPS);
-            plan.path[k].speed_mps = v_mps;
-            if k + 1 < n {
-                let (a, b) = (plan.path[k], plan.path[k + 1]);
-                let ds_m = (b.x_m - a.x_m).hypot(b.y_m - a.y_m);
-                plan.path[k + 1].t_s = t_s + ds_m / v_mps;
-            }
-        }
+        retime_path(&mut plan.path, profile);
         plan.shared.waypoints = plan
             .path
             .iter()

@@ -1,6 +1,6 @@
 //! What a simulation is made of: the shared settings and the vehicles to spawn.
 
-use planner::{Lane, MergeRoad, PlannerKind, PlannerParams, SpeedProfile};
+use planner::{Lane, MergeRoad, PlannerParams, SpeedProfile};
 use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
 
@@ -108,15 +108,16 @@ impl SimConfig {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Driver {
-    /// A potential-field planner of the given kind.
-    Planner(PlannerKind),
+    /// A planner by its registered name: `pf-cs`, `pf-sp`, `pf-sp-eq10`, `pf-iso`,
+    /// `pf-iso-pred`, or a user's (`crate::registry`).
+    Planner(String),
     /// The path of a potential-field planner (`path_planner`), the speeds of a prescribed
     /// time → speed profile (`speed_profile = [[t_s, speed_mps], …]`, linear in between, held
     /// outside). Not changed by `--planner`. Tests whether a given speed profile (e.g. the
     /// paper's pre-braking) changes the winding, without the speed optimiser.
     Prescribed {
-        /// Planner whose path the vehicle follows.
-        path_planner: PlannerKind,
+        /// Planner (registered name) whose path the vehicle follows.
+        path_planner: String,
         /// The speeds.
         speed_profile: SpeedProfile,
     },

@@ -24,6 +24,24 @@ pub enum SimError {
         /// What the planner said.
         source: planner::PlannerError,
     },
+    /// A scenario names a planner the registry does not hold.
+    #[error("vehicles[{vehicle}].driver: unknown planner {name:?} (registered: {valid})")]
+    UnknownPlanner {
+        /// The vehicle's name.
+        vehicle: String,
+        /// The name asked for.
+        name: String,
+        /// The registered names, comma separated.
+        valid: String,
+    },
+    /// A vehicle's behaviour failed to plan.
+    #[error("behaviour of vehicle {vehicle}: {source}")]
+    Behaviour {
+        /// The vehicle's name.
+        vehicle: String,
+        /// What it said.
+        source: mergesim_types::BehaviourError,
+    },
     /// The physics diverged (non-finite or runaway state).
     #[error("simulation diverged at t = {t_s} s: {what}")]
     Diverged {

@@ -1,17 +1,34 @@
-//! The closed-loop merge simulation: the `World` (rapier physics, vehicles, planners, trackers),
-//! the V2V bus, exact parry safety checks, metrics and the Rerun recording.
+//! The closed-loop merge simulation: the `World` (rapier physics, vehicles and their behaviours),
+//! the V2V bus, exact parry safety checks, the observers of a run (metrics, time series, Rerun
+//! recording), the simulator's own drivers and the registry of planners by name.
+#![warn(missing_docs)]
+
+pub mod agent;
 pub mod body_state;
 pub mod config;
+pub mod drivers;
 pub mod error;
 pub mod idm;
 pub mod metrics;
+pub mod observer;
+pub mod outcome;
 pub mod paper_metrics;
 pub mod recording;
+pub mod recording_observer;
+pub mod registry;
 pub mod rng;
+pub mod run_log;
 pub mod safety;
 pub mod v2v;
 pub mod world;
 
 pub use config::{Driver, SimConfig, VehicleSpec, validate_vehicles};
 pub use error::SimError;
-pub use world::{PlannerStats, RunOptions, RunOutcome, TimeSeriesRow, World};
+pub use mergesim_types::{
+    Behaviour, BehaviourError, Decision, GridSpec, Lane, MergeRoad, Neighbour, Observation,
+    PathPoint, SharedLocalPath, TimedWaypoint, VehicleId, VehicleShape, VehicleState,
+};
+pub use observer::{PlanView, TickObserver, VehicleView};
+pub use outcome::{PlannerStats, RunOutcome, TimeSeriesRow};
+pub use registry::{BehaviourFactory, BehaviourRegistry, FactoryInput};
+pub use world::{RunOptions, World};

@@ -1,155 +1,39 @@
-//! The closed-loop simulation: one `World` owns the physics, the vehicles, their planners and
-//! trackers, the V2V bus, the safety monitor, the metrics and the recorder, and advances them in
-//! the fixed order of the tick (README, "Layout"):
+//! The closed-loop simulation: one `World` owns the physics, the vehicles and their behaviours,
+//! the V2V bus and the safety monitor, and advances them in a fixed order every physics step:
 //!
 //! 1. V2V delivery → 2. planning (each vehicle at its own period, visited by id) and broadcast →
 //! 3. tracking → 4. tire and suspension forces, rapier step → 5. parry safety checks →
-//! 6. metrics, time series and recording (on their own clock).
+//! 6. the observers: metrics, time series and recording (on their own clock; `crate::observer`).
 //!
 //! Same configuration + same seed ⇒ bitwise identical results: vehicles are visited by index,
 //! every map is ordered, and the only randomness (V2V drops) comes from a seeded stream.
 
 use std::time::Instant;
 
-use planner::{
-    Neighbour, PathPoint, PfPlanner, Plan, PlanRequest, PlannerKind, SharedLocalPath, VehicleId,
-    VehicleShape, VehicleState,
+use mergesim_types::{
+    Decision, GridSpec, Neighbour, Observation, PathPoint, SharedLocalPath, VehicleId, VehicleState,
 };
-use serde::{Deserialize, Serialize};
-use vehicles::{Kinematics, PhysicsWorld, Tracker, Vehicle, VehicleParams};
+use vehicles::{Kinematics, PhysicsWorld};
 
-use crate::config::{Driver, SimConfig, VehicleSpec};
+use crate::agent::Agent;
+use crate::config::{SimConfig, VehicleSpec};
+use crate::drivers::lane_path;
 use crate::error::SimError;
-use crate::idm::{RoadUser, find_leader, idm_acceleration, speed_after_distance};
-use crate::metrics::{MetricsSample, VehicleMetrics, VehicleMetricsSummary};
+use crate::metrics::{MetricsSample, VehicleMetrics};
+use crate::observer::{PlanView, TickObserver, VehicleView};
+use crate::outcome::{PlannerStats, RunOutcome};
 use crate::recording::{EventLevel, Recorder};
-use crate::safety::{BodyState, SafetyMonitor, SafetySummary};
-
-fn rec(e: crate::recording::RecordingError) -> SimError {
-    SimError::Recording(e.to_string())
-}
-use crate::v2v::{V2vBus, V2vStats};
-
-/// One row of the time series (`--csv`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct TimeSeriesRow {
-    /// Simulated time (s).
-    pub t_s: f64,
-    /// Vehicle name.
-    pub vehicle: String,
-    /// Position (m).
-    pub x_m: f64,
-    /// Position (m).
-    pub y_m: f64,
-    /// Heading (rad).
-    pub yaw_rad: f64,
-    /// Yaw rate (rad/s).
-    pub yaw_rate_radps: f64,
-    /// Sideslip at the centre of gravity (rad).
-    pub sideslip_rad: f64,
-    /// Speed (m/s).
-    pub speed_mps: f64,
-    /// Speed the current plan asks for now (m/s).
-    pub planned_speed_mps: f64,
-    /// Longitudinal acceleration, body frame (m/s²).
-    pub accel_long_mps2: f64,
-    /// Lateral acceleration, body frame (m/s²).
-    pub accel_lat_mps2: f64,
-}
-
-impl TimeSeriesRow {
-    /// The row of vehicle `name` for one metrics sample and the speed its plan asked for.
-    pub fn from_sample(name: &str, sample: &MetricsSample, planned_speed_mps: f64) -> Self {
-        Self {
-            t_s: sample.t_s,
-            vehicle: name.to_string(),
-            x_m: sample.x_m,
-            y_m: sample.y_m,
-            yaw_rad: sample.yaw_rad,
-            yaw_rate_radps: sample.yaw_rate_radps,
-            sideslip_rad: sample.sideslip_rad,
-            speed_mps: sample.speed_mps,
-            planned_speed_mps,
-            accel_long_mps2: sample.accel_long_mps2,
-            accel_lat_mps2: sample.accel_lat_mps2,
-        }
-    }
-
-    /// CSV header, in the order of [`TimeSeriesRow::csv_line`].
-    pub const CSV_HEADER: &'static str = "t_s,vehicle,x_m,y_m,yaw_rad,yaw_rate_radps,sideslip_rad,speed_mps,planned_speed_mps,accel_long_mps2,accel_lat_mps2";
-
-    /// One CSV line (no newline).
-    pub fn csv_line(&self) -> String {
-        format!(
-            "{:.4},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
-            self.t_s,
-            self.vehicle,
-            self.x_m,
-            self.y_m,
-            self.yaw_rad,
-            self.yaw_rate_radps,
-            self.sideslip_rad,
-            self.speed_mps,
-            self.planned_speed_mps,
-            self.accel_long_mps2,
-            self.accel_lat_mps2
-        )
-    }
-}
-
-/// Planner timing and fault counters over a run.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct PlannerStats {
-    /// Planning cycles run.
-    pub plans: u64,
-    /// Cycles that returned a fallback plan.
-    pub fallbacks: u64,
-    /// Median wall time of one cycle (µs). Wall-clock: not part of the determinism contract.
-    pub p50_plan_us: f64,
-    /// 99th percentile wall time of one cycle (µs).
-    pub p99_plan_us: f64,
-}
-
-/// The result of a run.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RunOutcome {
-    /// Simulated time (s).
-    pub duration_s: f64,
-    /// Exact safety results.
-    pub safety: SafetySummary,
-    /// Per-vehicle metrics, in vehicle order.
-    pub vehicles: Vec<VehicleMetricsSummary>,
-    /// Planner counters.
-    pub planner_stats: PlannerStats,
-    /// V2V counters.
-    pub v2v: V2vStats,
-    /// Time series at the log period (empty unless requested).
-    pub time_series: Vec<TimeSeriesRow>,
-    /// Event log lines (collisions, near misses, fallbacks), in time order.
-    pub events: Vec<String>,
-}
-
-/// A vehicle of the world with its decision making.
-struct Agent {
-    id: VehicleId,
-    spec: VehicleSpec,
-    shape: VehicleShape,
-    vehicle: Vehicle,
-    planner: Option<PfPlanner>,
-    tracker: Tracker,
-    /// The path being tracked (plan output or lane-keeping line).
-    path: Vec<PathPoint>,
-    last_plan: Option<Plan>,
-    metrics: VehicleMetrics,
-    /// Whether a vehicle that started in the ending lane has crossed the divider yet.
-    merged: bool,
-}
+use crate::recording_observer::RecordingObserver;
+use crate::registry::BehaviourRegistry;
+use crate::run_log::RunLog;
+use crate::safety::{BodyState, SafetyMonitor};
+use crate::v2v::V2vBus;
 
 /// Options of one run that are not part of the scenario.
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
-    /// Override every planner vehicle's planner kind.
-    pub planner_override: Option<PlannerKind>,
+    /// Override every `driver = { planner = … }` vehicle's planner with this registered name.
+    pub planner_override: Option<String>,
     /// Seed of the run's random streams (V2V drops).
     pub seed: u64,
     /// Keep the time series in the outcome (for `--csv`).
@@ -163,9 +47,9 @@ pub struct World {
     agents: Vec<Agent>,
     bus: V2vBus,
     safety: SafetyMonitor,
-    recorder: Recorder,
-    keep_time_series: bool,
-    time_series: Vec<TimeSeriesRow>,
+    run_log: RunLog,
+    recording: RecordingObserver,
+    observers: Vec<Box<dyn TickObserver>>,
     events: Vec<String>,
     plan_times_us: Vec<f64>,
     fallbacks: u64,
@@ -183,12 +67,30 @@ fn steps_for(period_s: f64, dt_s: f64) -> u64 {
 }
 
 impl World {
-    /// Builds the world: validates everything, spawns the road and the vehicles.
+    /// Builds the world with the built-in planners: validates everything, spawns the road and
+    /// the vehicles.
     pub fn new(
         config: SimConfig,
         specs: &[VehicleSpec],
         options: &RunOptions,
         recorder: Recorder,
+    ) -> Result<Self, SimError> {
+        Self::with_registry(
+            config,
+            specs,
+            options,
+            recorder,
+            &BehaviourRegistry::builtin(),
+        )
+    }
+
+    /// [`World::new`] with the planners of `registry` (a user's own among them).
+    pub fn with_registry(
+        config: SimConfig,
+        specs: &[VehicleSpec],
+        options: &RunOptions,
+        recorder: Recorder,
+        registry: &BehaviourRegistry,
     ) -> Result<Self, SimError> {
         config.validate()?;
         crate::config::validate_vehicles(&config, specs)?;
@@ -196,21 +98,29 @@ impl World {
         physics.add_merge_road(&config.road);
         let mut agents = Vec::with_capacity(specs.len());
         for (index, spec) in specs.iter().enumerate() {
-            agents.push(Self::spawn_agent(
+            agents.push(Agent::spawn(
                 &config,
                 &mut physics,
                 index,
                 spec,
-                options,
+                registry,
+                options.planner_override.as_deref(),
             )?);
         }
         let bus = V2vBus::new(
             config.v2v.clone(),
             crate::rng::SplitMix64::derive(options.seed, 1),
         )?;
-        let safety =
-            SafetyMonitor::new(config.safety.clone(), &config.road).map_err(SimError::from)?;
-        let mut world = Self {
+        let safety = SafetyMonitor::new(config.safety.clone(), &config.road)?;
+        let metrics = agents
+            .iter()
+            .map(|a| {
+                VehicleMetrics::new(a.spec.name.clone())
+                    .with_paper_metrics(&config.road, a.spec.target_speed_mps)
+            })
+            .collect();
+        let recording = RecordingObserver::new(recorder, &config.road)?;
+        Ok(Self {
             steps_per_plan: steps_for(config.planner_period_s, config.dt_s),
             steps_per_log: steps_for(config.log_period_s, config.dt_s),
             steps_per_field: steps_for(config.field_log_period_s, config.dt_s),
@@ -220,66 +130,21 @@ impl World {
             agents,
             bus,
             safety,
-            recorder,
-            keep_time_series: options.keep_time_series,
-            time_series: Vec::new(),
+            run_log: RunLog::new(metrics, options.keep_time_series),
+            recording,
+            observers: Vec::new(),
             events: Vec::new(),
             plan_times_us: Vec::new(),
             fallbacks: 0,
             step_index: 0,
             reported_collisions: 0,
             reported_edge_contacts: 0,
-        };
-        world.recorder.log_road(&world.config.road).map_err(rec)?;
-        Ok(world)
+        })
     }
 
-    fn spawn_agent(
-        config: &SimConfig,
-        physics: &mut PhysicsWorld,
-        index: usize,
-        spec: &VehicleSpec,
-        options: &RunOptions,
-    ) -> Result<Agent, SimError> {
-        let params = VehicleParams::preset(&spec.preset)?;
-        let y_m = config.road.lane_center_y_m(spec.lane) + spec.y_offset_m;
-        let vehicle = Vehicle::spawn(physics, &params, spec.x_m, y_m, 0.0, spec.speed_mps)?;
-        let shape = vehicle.shape(VehicleShape::default().max_brake_decel_mps2);
-        let planner = match &spec.driver {
-            Driver::Prescribed { path_planner, .. } => Some(
-                PfPlanner::new(*path_planner, config.planner.clone(), config.road.clone())
-                    .map_err(|source| SimError::Planner {
-                        vehicle: spec.name.clone(),
-                        source,
-                    })?,
-            ),
-            Driver::Planner(kind) => {
-                let kind = options.planner_override.unwrap_or(*kind);
-                Some(
-                    PfPlanner::new(kind, config.planner.clone(), config.road.clone()).map_err(
-                        |source| SimError::Planner {
-                            vehicle: spec.name.clone(),
-                            source,
-                        },
-                    )?,
-                )
-            }
-            Driver::LaneKeeping | Driver::Idm => None,
-        };
-        let tracker = Tracker::new(config.tracker.clone(), &params);
-        Ok(Agent {
-            id: index as VehicleId,
-            spec: spec.clone(),
-            shape,
-            vehicle,
-            planner,
-            tracker,
-            path: Vec::new(),
-            last_plan: None,
-            metrics: VehicleMetrics::new(spec.name.clone())
-                .with_paper_metrics(&config.road, spec.target_speed_mps),
-            merged: spec.lane == planner::Lane::Upper,
-        })
+    /// Adds an observer, called after the built-in ones.
+    pub fn add_observer(&mut self, observer: Box<dyn TickObserver>) {
+        self.observers.push(observer);
     }
 
     /// Simulated time now (s).
@@ -319,7 +184,15 @@ impl World {
         for agent in &mut self.agents {
             let kin = agent.vehicle.kinematics(&self.physics);
             if agent.path.is_empty() {
-                agent.path = lane_keeping_path(&self.config, &agent.spec, &kin, t_s);
+                let v = agent.spec.target_speed_mps;
+                agent.path = lane_path(
+                    &self.config.road,
+                    agent.spec.lane,
+                    agent.spec.y_offset_m,
+                    kin.x_m,
+                    t_s,
+                    |_| v,
+                );
             }
             let controls = agent.tracker.update(&kin, &agent.path, dt_s);
             agent.vehicle.set_controls(controls);
@@ -352,11 +225,31 @@ impl World {
                     })?;
                 self.report_new_collisions()?;
             }
-            // 6. Metrics, time series, recording.
+            // 6. Observers.
             if need_log {
                 self.log_instant(t_s, &kins, &bodies)?;
             }
         }
+        Ok(())
+    }
+
+    /// Every observer, built-in first.
+    fn each_observer(
+        &mut self,
+        mut f: impl FnMut(&mut dyn TickObserver) -> Result<(), SimError>,
+    ) -> Result<(), SimError> {
+        f(&mut self.run_log)?;
+        f(&mut self.recording)?;
+        for observer in &mut self.observers {
+            f(observer.as_mut())?;
+        }
+        Ok(())
+    }
+
+    /// Records an event in the run's log and tells the observers.
+    fn event(&mut self, text: String, level: EventLevel) -> Result<(), SimError> {
+        self.each_observer(|o| o.on_event(&text, level))?;
+        self.events.push(text);
         Ok(())
     }
 
@@ -394,38 +287,33 @@ impl World {
 
     fn report_new_collisions(&mut self) -> Result<(), SimError> {
         let names = self.names();
-        let collisions = self.safety.collision_events();
-        while self.reported_collisions < collisions.len() {
-            let event = &collisions[self.reported_collisions];
-            let text = event.describe(&names);
-            self.recorder
-                .log_event(&text, EventLevel::Error)
-                .map_err(rec)?;
-            self.events.push(text);
-            for agent in &mut self.agents {
-                if event.involves(agent.id) {
-                    agent.metrics.set_collided();
-                }
-            }
+        while self.reported_collisions < self.safety.collision_events().len() {
+            let event = self.safety.collision_events()[self.reported_collisions].clone();
+            let ids: Vec<VehicleId> = self
+                .agents
+                .iter()
+                .map(|a| a.id)
+                .filter(|id| event.involves(*id))
+                .collect();
+            self.event(event.describe(&names), EventLevel::Error)?;
+            self.each_observer(|o| {
+                o.on_collision(&ids);
+                Ok(())
+            })?;
             self.reported_collisions += 1;
         }
-        let contacts = self.safety.edge_contact_events();
-        while self.reported_edge_contacts < contacts.len() {
-            let event = &contacts[self.reported_edge_contacts];
+        while self.reported_edge_contacts < self.safety.edge_contact_events().len() {
+            let event = self.safety.edge_contact_events()[self.reported_edge_contacts].clone();
             let name = names.get(event.id as usize).cloned().unwrap_or_default();
             let text = format!(
                 "t = {:.3} s: vehicle {name} hit the {:?} road edge",
                 event.t_s, event.edge
             );
-            self.recorder
-                .log_event(&text, EventLevel::Error)
-                .map_err(rec)?;
-            self.events.push(text);
-            for agent in &mut self.agents {
-                if agent.id == event.id {
-                    agent.metrics.set_collided();
-                }
-            }
+            self.event(text, EventLevel::Error)?;
+            self.each_observer(|o| {
+                o.on_collision(&[event.id]);
+                Ok(())
+            })?;
             self.reported_edge_contacts += 1;
         }
         Ok(())
@@ -450,7 +338,10 @@ impl World {
                 speed_mps: k.speed_mps,
             })
             .collect();
-        let ids: Vec<VehicleId> = self.agents.iter().map(|a| a.id).collect();
+        let field_due = self.step_index.is_multiple_of(self.steps_per_field);
+        // The observation borrows these while the world records events.
+        let road = self.config.road.clone();
+        let mu = self.config.mu;
         let mut broadcasts: Vec<SharedLocalPath> = Vec::new();
         for index in 0..self.agents.len() {
             check_finite(t_s, &self.agents[index].spec.name, &kins[index])?;
@@ -465,92 +356,75 @@ impl World {
                     shape: other.shape,
                 })
                 .collect();
-            if self.agents[index].spec.driver == Driver::Idm {
-                let users: Vec<RoadUser> = self
-                    .agents
-                    .iter()
-                    .zip(&kins)
-                    .map(|(a, k)| RoadUser {
-                        x_m: k.x_m,
-                        y_m: k.y_m,
-                        speed_mps: k.speed_mps,
-                        length_m: a.shape.length_m,
-                    })
-                    .collect();
-                let leader = find_leader(&self.config.idm, &users, index);
-                let agent = &mut self.agents[index];
-                let v = kins[index].speed_mps;
-                let accel_mps2 = idm_acceleration(
-                    &self.config.idm,
-                    v,
-                    agent.spec.target_speed_mps,
-                    leader.as_ref(),
-                );
-                agent.path = lane_path(&self.config, &agent.spec, &kins[index], t_s, |d| {
-                    speed_after_distance(v, accel_mps2, d)
-                });
-                continue;
-            }
-            let agent = &mut self.agents[index];
-            let Some(planner) = agent.planner.as_mut() else {
-                agent.path = lane_keeping_path(&self.config, &agent.spec, &kins[index], t_s);
-                continue;
-            };
+            let agent = &self.agents[index];
             let shared_paths = if agent.spec.connected {
                 self.bus.fresh_paths(agent.id, t_s)
             } else {
                 Vec::new()
             };
-            let request = PlanRequest {
+            let observation = Observation {
                 time_s: t_s,
                 ego_id: agent.id,
                 ego: states[index],
                 ego_shape: agent.shape,
                 target_speed_mps: agent.spec.target_speed_mps,
-                mu: self.config.mu,
+                mu,
+                road: &road,
                 neighbours: &neighbours,
                 shared_paths: &shared_paths,
             };
+            let agent = &mut self.agents[index];
+            let is_planner = agent.behaviour.is_planner();
             let started = Instant::now();
-            let plan = planner.plan(&request).map_err(|source| SimError::Planner {
-                vehicle: agent.spec.name.clone(),
-                source,
-            })?;
-            self.plan_times_us
-                .push(started.elapsed().as_secs_f64() * 1e6);
-            if let Some(reason) = &plan.fallback {
-                self.fallbacks += 1;
-                let text = format!(
-                    "t = {t_s:.2} s: planner fallback of {}: {reason:?}",
-                    agent.spec.name
-                );
-                self.recorder
-                    .log_event(&text, EventLevel::Warn)
-                    .map_err(rec)?;
-                self.events.push(text);
-            }
-            if self.step_index.is_multiple_of(self.steps_per_field) && self.recorder.is_enabled() {
-                log_field(&mut self.recorder, planner, &request, &agent.spec.name)?;
-            }
-            let plan = match &agent.spec.driver {
-                Driver::Prescribed { speed_profile, .. } if plan.fallback.is_none() => {
-                    plan.with_speed_profile(speed_profile)
+            let decision: Decision =
+                agent
+                    .behaviour
+                    .plan(&observation)
+                    .map_err(|source| SimError::Behaviour {
+                        vehicle: agent.spec.name.clone(),
+                        source,
+                    })?;
+            let elapsed_us = started.elapsed().as_secs_f64() * 1e6;
+            let name = agent.spec.name.clone();
+            let connected = agent.spec.connected;
+            if is_planner {
+                self.plan_times_us.push(elapsed_us);
+                if let Some(reason) = &decision.fallback {
+                    self.fallbacks += 1;
+                    self.event(
+                        format!("t = {t_s:.2} s: planner fallback of {name}: {reason}"),
+                        EventLevel::Warn,
+                    )?;
                 }
-                _ => plan,
-            };
-            agent.path = plan.path.clone();
-            if agent.spec.connected {
-                broadcasts.push(plan.shared.clone());
+                let behaviour = &self.agents[index].behaviour;
+                let field = |spec: &GridSpec| behaviour.potential_field(&observation, spec);
+                let view = PlanView {
+                    name: &name,
+                    observation: &observation,
+                    decision: &decision,
+                    field: &field,
+                    field_due,
+                };
+                self.run_log.on_plan(t_s, &view)?;
+                self.recording.on_plan(t_s, &view)?;
+                for observer in &mut self.observers {
+                    observer.on_plan(t_s, &view)?;
+                }
             }
-            agent.last_plan = Some(plan);
+            let agent = &mut self.agents[index];
+            agent.path = decision.path;
+            if connected && let Some(message) = decision.broadcast {
+                broadcasts.push(message);
+            }
         }
         // Broadcast after everybody planned on the same information (a synchronous round).
+        let receivers: Vec<VehicleId> = self
+            .agents
+            .iter()
+            .filter(|a| a.spec.connected)
+            .map(|a| a.id)
+            .collect();
         for message in &broadcasts {
-            let receivers: Vec<VehicleId> = ids
-                .iter()
-                .copied()
-                .filter(|id| self.agents[*id as usize].spec.connected)
-                .collect();
             self.bus.broadcast(t_s, message, &receivers);
         }
         Ok(())
@@ -562,26 +436,26 @@ impl World {
         kins: &[Kinematics],
         bodies: &[BodyState],
     ) -> Result<(), SimError> {
-        if self.recorder.is_enabled() {
-            let names = self.names();
-            self.recorder.set_time(t_s).map_err(rec)?;
-            self.recorder.log_vehicles(bodies, &names).map_err(rec)?;
-        }
+        // Lane changes first (events), then the observers.
         let y_lane_m = self.config.road.y_lane_m();
+        let mut crossings = Vec::new();
         for (agent, k) in self.agents.iter_mut().zip(kins) {
             if !agent.merged && k.y_m > y_lane_m {
                 agent.merged = true;
-                let text = format!(
+                crossings.push(format!(
                     "t = {t_s:.2} s: {} crossed the lane divider at x = {:.1} m",
                     agent.spec.name, k.x_m
-                );
-                self.recorder
-                    .log_event(&text, EventLevel::Info)
-                    .map_err(rec)?;
-                self.events.push(text);
+                ));
             }
-            let planned_speed_mps = planned_speed_at(&agent.path, t_s).unwrap_or(k.speed_mps);
-            let sample = MetricsSample {
+        }
+        for text in crossings {
+            self.event(text, EventLevel::Info)?;
+        }
+        let want_received = self.recording.wants_received_paths()
+            || self.observers.iter().any(|o| o.wants_received_paths());
+        let samples: Vec<MetricsSample> = kins
+            .iter()
+            .map(|k| MetricsSample {
                 t_s,
                 x_m: k.x_m,
                 y_m: k.y_m,
@@ -591,45 +465,39 @@ impl World {
                 speed_mps: k.speed_mps,
                 accel_long_mps2: k.accel_long_mps2,
                 accel_lat_mps2: k.accel_lat_mps2,
-            };
-            agent
-                .metrics
-                .push(&sample)
-                .map_err(|e| SimError::Diverged {
-                    t_s,
-                    what: format!("metrics of {}: {e}", agent.spec.name),
-                })?;
-            if self.recorder.is_enabled() {
-                let name = &agent.spec.name;
-                self.recorder
-                    .log_scalars(
-                        name,
-                        &[
-                            ("sideslip_rad", k.sideslip_rad),
-                            ("yaw_rad", k.yaw_rad),
-                            ("yaw_rate_radps", k.yaw_rate_radps),
-                            ("speed_mps", k.speed_mps),
-                            ("planned_speed_mps", planned_speed_mps),
-                        ],
-                    )
-                    .map_err(rec)?;
-                self.recorder
-                    .log_planned_path(name, &agent.path)
-                    .map_err(rec)?;
-                if agent.spec.connected {
-                    let received = self.bus.fresh_paths(agent.id, t_s);
-                    self.recorder
-                        .log_received_paths(name, &received)
-                        .map_err(rec)?;
+            })
+            .collect();
+        let received: Vec<Vec<SharedLocalPath>> = self
+            .agents
+            .iter()
+            .map(|a| {
+                if want_received && a.spec.connected {
+                    self.bus.fresh_paths(a.id, t_s)
+                } else {
+                    Vec::new()
                 }
-            }
-            if self.keep_time_series {
-                self.time_series.push(TimeSeriesRow::from_sample(
-                    &agent.spec.name,
-                    &sample,
-                    planned_speed_mps,
-                ));
-            }
+            })
+            .collect();
+        let views: Vec<VehicleView<'_>> = self
+            .agents
+            .iter()
+            .enumerate()
+            .map(|(i, a)| VehicleView {
+                id: a.id,
+                name: &a.spec.name,
+                kinematics: &kins[i],
+                body: &bodies[i],
+                sample: &samples[i],
+                path: &a.path,
+                planned_speed_mps: planned_speed_at(&a.path, t_s).unwrap_or(kins[i].speed_mps),
+                connected: a.spec.connected,
+                received: &received[i],
+            })
+            .collect();
+        self.run_log.on_log(t_s, &views)?;
+        self.recording.on_log(t_s, &views)?;
+        for observer in &mut self.observers {
+            observer.on_log(t_s, &views)?;
         }
         Ok(())
     }
@@ -648,10 +516,7 @@ impl World {
                     .map(|t| format!("{t:.2} s"))
                     .unwrap_or_else(|| "none".into())
             );
-            self.recorder
-                .log_event(&text, EventLevel::Warn)
-                .map_err(rec)?;
-            self.events.push(text);
+            self.event(text, EventLevel::Warn)?;
         }
         let mut times = self.plan_times_us.clone();
         times.sort_by(f64::total_cmp);
@@ -661,17 +526,17 @@ impl World {
             p50_plan_us: percentile(&times, 0.50),
             p99_plan_us: percentile(&times, 0.99),
         };
-        let vehicles = self.agents.iter().map(|a| a.metrics.summary()).collect();
+        let vehicles = self.run_log.summaries();
         let v2v = self.bus.stats();
         let duration_s = self.time_s();
-        self.recorder.finish().map_err(rec)?;
+        self.each_observer(|o| o.finish())?;
         Ok(RunOutcome {
             duration_s,
             safety,
             vehicles,
             planner_stats,
             v2v,
-            time_series: self.time_series,
+            time_series: self.run_log.into_time_series(),
             events: self.events,
         })
     }
@@ -722,73 +587,4 @@ fn planned_speed_at(path: &[PathPoint], t_s: f64) -> Option<f64> {
         }
     }
     path.last().map(|p| p.speed_mps)
-}
-
-/// A straight path along the spawn lane's centre at the target speed (driver without planner).
-fn lane_keeping_path(
-    config: &SimConfig,
-    spec: &VehicleSpec,
-    k: &Kinematics,
-    t_s: f64,
-) -> Vec<PathPoint> {
-    let v = spec.target_speed_mps;
-    lane_path(config, spec, k, t_s, |_| v)
-}
-
-/// A straight path along the spawn lane's centre, 50 m ahead in 2.5 m steps, with the speed
-/// `speed_at(distance ahead)` and times integrated from the mean speed of each step.
-fn lane_path(
-    config: &SimConfig,
-    spec: &VehicleSpec,
-    k: &Kinematics,
-    t_s: f64,
-    speed_at: impl Fn(f64) -> f64,
-) -> Vec<PathPoint> {
-    const STEP_M: f64 = 2.5;
-    const POINTS: usize = 21;
-    let y_m = config.road.lane_center_y_m(spec.lane) + spec.y_offset_m;
-    let mut points = Vec::with_capacity(POINTS);
-    let mut t = t_s;
-    let mut previous_speed = speed_at(0.0);
-    for i in 0..POINTS {
-        let ahead_m = STEP_M * i as f64;
-        let speed_mps = speed_at(ahead_m);
-        if i > 0 {
-            t += STEP_M / (0.5 * (previous_speed + speed_mps)).max(0.1);
-        }
-        previous_speed = speed_mps;
-        points.push(PathPoint {
-            x_m: k.x_m + ahead_m,
-            y_m,
-            speed_mps,
-            t_s: t,
-        });
-    }
-    points
-}
-
-/// Samples the ego's potential field on a window around it and logs it as an image.
-fn log_field(
-    recorder: &mut Recorder,
-    planner: &PfPlanner,
-    request: &PlanRequest,
-    name: &str,
-) -> Result<(), SimError> {
-    let cell_m = 0.5;
-    let x0_m = request.ego.x_m - 20.0;
-    let road = planner.road();
-    let y0_m = road.y_bottom_m;
-    let width = 240usize;
-    let height = ((road.y_upper_m() - road.y_bottom_m) / cell_m).ceil() as usize;
-    let mut values = Vec::with_capacity(width * height);
-    for row in 0..height {
-        let y_m = y0_m + (row as f64 + 0.5) * cell_m;
-        for col in 0..width {
-            let x_m = x0_m + (col as f64 + 0.5) * cell_m;
-            values.push(planner.field_value(request, x_m, y_m));
-        }
-    }
-    recorder
-        .log_field(name, x0_m, y0_m, cell_m, width, height, &values)
-        .map_err(rec)
 }

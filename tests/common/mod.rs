@@ -5,33 +5,31 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use mergesim::experiment::{InstanceOptions, run_quietly};
 use mergesim::planner::PlannerKind;
 use mergesim::scenarios::Scenario;
-use mergesim::sim::recording::Recorder;
-use mergesim::sim::{RunOptions, RunOutcome, World};
+use mergesim::sim::RunOutcome;
 
 /// Runs `scenario` in the closed loop without recording (`planner` overrides every
-/// planner-driven vehicle's planner); a failure panics with the scenario's name.
+/// planner-driven vehicle's planner; `seed` seeds the V2V drops of the nominal scenario) through
+/// the library's one entry, `mergesim::experiment`; a failure panics with the scenario's name.
 pub fn simulate(
     scenario: &Scenario,
     planner: Option<PlannerKind>,
     seed: u64,
     keep_time_series: bool,
 ) -> RunOutcome {
-    let options = RunOptions {
-        planner_override: planner,
-        seed,
+    // The nominal scenario with the run's seed for the V2V stream (not a drawn instance).
+    let mut nominal = scenario.clone();
+    nominal.randomise = Default::default();
+    let options = InstanceOptions {
+        planner: planner.map(|k| k.name().to_string()),
+        seed: Some(seed),
         keep_time_series,
     };
-    World::new(
-        scenario.sim.clone(),
-        &scenario.vehicles,
-        &options,
-        Recorder::disabled(),
-    )
-    .unwrap_or_else(|e| panic!("{}: {e}", scenario.name))
-    .run(|_| {})
-    .unwrap_or_else(|e| panic!("{}: {e}", scenario.name))
+    run_quietly(&nominal, &options)
+        .unwrap_or_else(|e| panic!("{}: {e}", scenario.name))
+        .outcome
 }
 
 /// Runs the `merge_sim` binary with `args` and extra environment `env`. The shard variables of

@@ -6,12 +6,14 @@
 //! speak these types, and depend on nothing else to do so.
 #![warn(missing_docs)]
 
+pub mod behaviour;
 pub mod error;
 pub mod grid;
 pub mod path;
 pub mod road;
 pub mod vehicle;
 
+pub use behaviour::{Behaviour, BehaviourError, Decision, Observation};
 pub use error::InvalidParameter;
 pub use grid::{GridSpec, MAX_GRID_CELLS};
 pub use path::{PathPoint, SharedLocalPath, TimedWaypoint};

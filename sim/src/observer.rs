@@ -1,0 +1,83 @@
+//! Observers of the tick: what is measured and recorded of a run, kept out of the tick loop.
+//!
+//! The [`crate::World`] advances the physics and the vehicles' decisions; at every planning cycle
+//! of a vehicle, at every logged instant (the log period, 20 Hz by default) and for every event
+//! it calls its observers in a fixed order: the per-vehicle metrics and time series
+//! ([`crate::run_log::RunLog`]), the Rerun recording ([`crate::recording_observer`]), then any
+//! observer a user added with [`crate::World::add_observer`].
+
+use mergesim_types::{Decision, GridSpec, Observation, PathPoint, SharedLocalPath, VehicleId};
+use vehicles::Kinematics;
+
+use crate::error::SimError;
+use crate::metrics::MetricsSample;
+use crate::recording::EventLevel;
+use crate::safety::BodyState;
+
+/// One vehicle at a logged instant.
+#[derive(Clone, Copy, Debug)]
+pub struct VehicleView<'a> {
+    /// Its id (index in the scenario).
+    pub id: VehicleId,
+    /// Its name.
+    pub name: &'a str,
+    /// Its kinematic state.
+    pub kinematics: &'a Kinematics,
+    /// Its chassis box, as the safety checks see it.
+    pub body: &'a BodyState,
+    /// Its motion state as the metrics see it.
+    pub sample: &'a MetricsSample,
+    /// The path it is tracking.
+    pub path: &'a [PathPoint],
+    /// The speed that path asks for now (m/s).
+    pub planned_speed_mps: f64,
+    /// Whether it is connected (sends and receives shared paths).
+    pub connected: bool,
+    /// The fresh shared paths it holds (empty unless an observer asked for them).
+    pub received: &'a [SharedLocalPath],
+}
+
+/// One vehicle's planning cycle.
+pub struct PlanView<'a, 'o> {
+    /// The vehicle's name.
+    pub name: &'a str,
+    /// What it observed.
+    pub observation: &'a Observation<'o>,
+    /// What it decided.
+    pub decision: &'a Decision,
+    /// Samples its potential field on a grid (`None` if it has none).
+    pub field: &'a dyn Fn(&GridSpec) -> Option<Vec<f64>>,
+    /// Whether the field-logging period has come.
+    pub field_due: bool,
+}
+
+/// Something that watches a run (module doc). Every method defaults to doing nothing.
+pub trait TickObserver {
+    /// Whether [`VehicleView::received`] should be filled (it costs a look-up per vehicle).
+    fn wants_received_paths(&self) -> bool {
+        false
+    }
+
+    /// A vehicle has planned.
+    fn on_plan(&mut self, _t_s: f64, _plan: &PlanView<'_, '_>) -> Result<(), SimError> {
+        Ok(())
+    }
+
+    /// A logged instant.
+    fn on_log(&mut self, _t_s: f64, _vehicles: &[VehicleView<'_>]) -> Result<(), SimError> {
+        Ok(())
+    }
+
+    /// An event (collision, road-edge contact, fallback, lane change, near miss).
+    fn on_event(&mut self, _text: &str, _level: EventLevel) -> Result<(), SimError> {
+        Ok(())
+    }
+
+    /// A collision involving these vehicles.
+    fn on_collision(&mut self, _ids: &[VehicleId]) {}
+
+    /// The run has ended.
+    fn finish(&mut self) -> Result<(), SimError> {
+        Ok(())
+    }
+}

@@ -1,0 +1,106 @@
+//! What a run produces: the outcome, its planner statistics and the time-series rows.
+
+use serde::{Deserialize, Serialize};
+
+use crate::metrics::{MetricsSample, VehicleMetricsSummary};
+use crate::safety::SafetySummary;
+use crate::v2v::V2vStats;
+
+/// One row of the time series (`--csv`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TimeSeriesRow {
+    /// Simulated time (s).
+    pub t_s: f64,
+    /// Vehicle name.
+    pub vehicle: String,
+    /// Position (m).
+    pub x_m: f64,
+    /// Position (m).
+    pub y_m: f64,
+    /// Heading (rad).
+    pub yaw_rad: f64,
+    /// Yaw rate (rad/s).
+    pub yaw_rate_radps: f64,
+    /// Sideslip at the centre of gravity (rad).
+    pub sideslip_rad: f64,
+    /// Speed (m/s).
+    pub speed_mps: f64,
+    /// Speed the current plan asks for now (m/s).
+    pub planned_speed_mps: f64,
+    /// Longitudinal acceleration, body frame (m/s²).
+    pub accel_long_mps2: f64,
+    /// Lateral acceleration, body frame (m/s²).
+    pub accel_lat_mps2: f64,
+}
+
+impl TimeSeriesRow {
+    /// The row of vehicle `name` for one metrics sample and the speed its plan asked for.
+    pub fn from_sample(name: &str, sample: &MetricsSample, planned_speed_mps: f64) -> Self {
+        Self {
+            t_s: sample.t_s,
+            vehicle: name.to_string(),
+            x_m: sample.x_m,
+            y_m: sample.y_m,
+            yaw_rad: sample.yaw_rad,
+            yaw_rate_radps: sample.yaw_rate_radps,
+            sideslip_rad: sample.sideslip_rad,
+            speed_mps: sample.speed_mps,
+            planned_speed_mps,
+            accel_long_mps2: sample.accel_long_mps2,
+            accel_lat_mps2: sample.accel_lat_mps2,
+        }
+    }
+
+    /// CSV header, in the order of [`TimeSeriesRow::csv_line`].
+    pub const CSV_HEADER: &'static str = "t_s,vehicle,x_m,y_m,yaw_rad,yaw_rate_radps,sideslip_rad,speed_mps,planned_speed_mps,accel_long_mps2,accel_lat_mps2";
+
+    /// One CSV line (no newline).
+    pub fn csv_line(&self) -> String {
+        format!(
+            "{:.4},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
+            self.t_s,
+            self.vehicle,
+            self.x_m,
+            self.y_m,
+            self.yaw_rad,
+            self.yaw_rate_radps,
+            self.sideslip_rad,
+            self.speed_mps,
+            self.planned_speed_mps,
+            self.accel_long_mps2,
+            self.accel_lat_mps2
+        )
+    }
+}
+
+/// Planner timing and fault counters over a run.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlannerStats {
+    /// Planning cycles run.
+    pub plans: u64,
+    /// Cycles that returned a fallback plan.
+    pub fallbacks: u64,
+    /// Median wall time of one cycle (µs). Wall-clock: not part of the determinism contract.
+    pub p50_plan_us: f64,
+    /// 99th percentile wall time of one cycle (µs).
+    pub p99_plan_us: f64,
+}
+
+/// The result of a run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunOutcome {
+    /// Simulated time (s).
+    pub duration_s: f64,
+    /// Exact safety results.
+    pub safety: SafetySummary,
+    /// Per-vehicle metrics, in vehicle order.
+    pub vehicles: Vec<VehicleMetricsSummary>,
+    /// Planner counters.
+    pub planner_stats: PlannerStats,
+    /// V2V counters.
+    pub v2v: V2vStats,
+    /// Time series at the log period (empty unless requested).
+    pub time_series: Vec<TimeSeriesRow>,
+    /// Event log lines (collisions, near misses, fallbacks), in time order.
+    pub events: Vec<String>,
+}

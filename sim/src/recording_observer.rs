@@ -1,0 +1,121 @@
+//! The built-in observer that writes the Rerun recording: the road once, then the vehicles'
+//! boxes, their planned and received paths and time series at every logged instant, each
+//! planning vehicle's potential field at the field period, and the events.
+
+use crate::error::SimError;
+use crate::observer::{PlanView, TickObserver, VehicleView};
+use crate::recording::{EventLevel, Recorder, RecordingError};
+use crate::safety::BodyState;
+use mergesim_types::GridSpec;
+
+fn rec(e: RecordingError) -> SimError {
+    SimError::Recording(e.to_string())
+}
+
+/// The field window: 120 m of road from 20 m behind the vehicle, the whole road's width, 0.5 m
+/// cells.
+fn field_grid(x_m: f64, road: &mergesim_types::MergeRoad) -> GridSpec {
+    let cell_m = 0.5;
+    GridSpec {
+        x_min_m: x_m - 20.0,
+        y_min_m: road.y_bottom_m,
+        cell_m,
+        columns: 240,
+        rows: ((road.y_upper_m() - road.y_bottom_m) / cell_m).ceil() as usize,
+    }
+}
+
+/// Writes a run into a [`Recorder`] (a disabled one makes this a no-op).
+pub struct RecordingObserver {
+    recorder: Option<Recorder>,
+}
+
+impl RecordingObserver {
+    /// Records into `recorder`, starting with the road.
+    pub fn new(mut recorder: Recorder, road: &mergesim_types::MergeRoad) -> Result<Self, SimError> {
+        recorder.log_road(road).map_err(rec)?;
+        Ok(Self {
+            recorder: Some(recorder),
+        })
+    }
+
+    fn enabled(&mut self) -> Option<&mut Recorder> {
+        self.recorder.as_mut().filter(|r| r.is_enabled())
+    }
+}
+
+impl TickObserver for RecordingObserver {
+    fn wants_received_paths(&self) -> bool {
+        self.recorder.as_ref().is_some_and(Recorder::is_enabled)
+    }
+
+    fn on_plan(&mut self, _t_s: f64, plan: &PlanView<'_, '_>) -> Result<(), SimError> {
+        if !plan.field_due {
+            return Ok(());
+        }
+        let Some(recorder) = self.enabled() else {
+            return Ok(());
+        };
+        let spec = field_grid(plan.observation.ego.x_m, plan.observation.road);
+        if let Some(values) = (plan.field)(&spec) {
+            recorder
+                .log_field(
+                    plan.name,
+                    spec.x_min_m,
+                    spec.y_min_m,
+                    spec.cell_m,
+                    spec.columns,
+                    spec.rows,
+                    &values,
+                )
+                .map_err(rec)?;
+        }
+        Ok(())
+    }
+
+    fn on_log(&mut self, t_s: f64, vehicles: &[VehicleView<'_>]) -> Result<(), SimError> {
+        let Some(recorder) = self.enabled() else {
+            return Ok(());
+        };
+        recorder.set_time(t_s).map_err(rec)?;
+        let bodies: Vec<BodyState> = vehicles.iter().map(|v| *v.body).collect();
+        let names: Vec<String> = vehicles.iter().map(|v| v.name.to_string()).collect();
+        recorder.log_vehicles(&bodies, &names).map_err(rec)?;
+        for v in vehicles {
+            let k = v.kinematics;
+            recorder
+                .log_scalars(
+                    v.name,
+                    &[
+                        ("sideslip_rad", k.sideslip_rad),
+                        ("yaw_rad", k.yaw_rad),
+                        ("yaw_rate_radps", k.yaw_rate_radps),
+                        ("speed_mps", k.speed_mps),
+                        ("planned_speed_mps", v.planned_speed_mps),
+                    ],
+                )
+                .map_err(rec)?;
+            recorder.log_planned_path(v.name, v.path).map_err(rec)?;
+            if v.connected {
+                recorder
+                    .log_received_paths(v.name, v.received)
+                    .map_err(rec)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn on_event(&mut self, text: &str, level: EventLevel) -> Result<(), SimError> {
+        if let Some(recorder) = self.recorder.as_mut() {
+            recorder.log_event(text, level).map_err(rec)?;
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self) -> Result<(), SimError> {
+        match self.recorder.take() {
+            Some(recorder) => recorder.finish().map_err(rec),
+            None => Ok(()),
+        }
+    }
+}

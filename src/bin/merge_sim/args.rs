@@ -1,0 +1,293 @@
+//! The command line: subcommands, their options and the parsers of option values.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use planner::{ParameterSet, PlannerKind};
+
+/// Cooperative merge simulator: potential-field planners with interactive speed optimisation
+/// (Lin et al.) on physics-based Rapier vehicles.
+///
+/// With no subcommand, `merge_sim` runs the paper's urgent merge with PF-ISO, prints a summary
+/// table and writes a Rerun recording (urgent_merge_pf-iso.rrd) in the current folder.
+#[derive(Parser, Debug)]
+#[command(name = "merge_sim", version, args_conflicts_with_subcommands = true)]
+pub(crate) struct Cli {
+    #[command(subcommand)]
+    pub(crate) command: Option<Command>,
+    #[command(flatten)]
+    pub(crate) run: RunArgs,
+}
+
+#[derive(Subcommand, Debug)]
+pub(crate) enum Command {
+    /// Run one scenario closed-loop (the default).
+    Run(RunArgs),
+    /// Run every planner on one scenario and print them side by side.
+    Compare(CompareArgs),
+    /// Open-loop vehicle-dynamics tests on a flat pad (no planner).
+    Maneuver(ManeuverArgs),
+    /// List or print the built-in scenarios.
+    #[command(subcommand)]
+    Scenario(ScenarioCommand),
+    /// Seeded Monte-Carlo sweep: N randomised instances in parallel, collision / near-miss
+    /// statistics (instance i runs with seed SplitMix64::derive(--seed, i); replay it alone with
+    /// `merge_sim run --scenario S --planner P --seed <that seed>`).
+    Sweep(SweepArgs),
+    /// Combine the --json files of the shards of one sweep into the aggregate of the whole sweep.
+    MergeResults(MergeResultsArgs),
+    /// Sensitivity grid: every planner on the same instances under {obstacles predicted in
+    /// Eq. 7 on/off} × {sub-steps on/off} × path time gap τ × interaction time gap τ_I, with
+    /// paired differences against the first planner.
+    Grid(GridArgs),
+}
+
+#[derive(Args, Debug, Clone)]
+pub(crate) struct RunArgs {
+    /// Built-in scenario name or path to a scenario TOML file.
+    #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
+    pub(crate) scenario: String,
+    /// Planner of every planner-driven vehicle (overrides the scenario's choice).
+    #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
+    pub(crate) planner: Option<PlannerKind>,
+    /// Planner parameter set: `paper` (the paper's literal reading) or `mergesim` (our
+    /// improvements) [default: the scenario's `params`, else mergesim]. The scenario's
+    /// [sim.planner] values apply on top of it.
+    #[arg(long, value_name = "SET", value_parser = parse_params)]
+    pub(crate) params: Option<ParameterSet>,
+    /// Run the scenario instance drawn with seed N from its [randomise] ranges (N also seeds
+    /// the V2V drops); a sweep's per-run rows give each run's seed. Without it the nominal
+    /// scenario runs.
+    #[arg(long, value_name = "N")]
+    pub(crate) seed: Option<u64>,
+    /// Where to write the Rerun recording [default: <scenario>_<planner>.rrd].
+    #[arg(long, value_name = "PATH", conflicts_with = "no_rrd")]
+    pub(crate) rrd: Option<PathBuf>,
+    /// Do not write a Rerun recording.
+    #[arg(long)]
+    pub(crate) no_rrd: bool,
+    /// Open the recording in the Rerun viewer afterwards (needs `rerun` on PATH).
+    #[arg(long, conflicts_with = "no_rrd")]
+    pub(crate) view: bool,
+    /// Write the JSON summary here.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) json: Option<PathBuf>,
+    /// Write the time series (one row per vehicle per logged instant) here.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) csv: Option<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct CompareArgs {
+    /// Built-in scenario name or path to a scenario TOML file.
+    #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
+    pub(crate) scenario: String,
+    /// Planners to compare, comma-separated.
+    #[arg(long, value_delimiter = ',', value_parser = parse_planner,
+          default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
+    pub(crate) planners: Vec<PlannerKind>,
+    /// Planner parameter set: `paper` (the paper's literal reading) or `mergesim` (our
+    /// improvements) [default: the scenario's `params`, else mergesim]. The scenario's
+    /// [sim.planner] values apply on top of it.
+    #[arg(long, value_name = "SET", value_parser = parse_params)]
+    pub(crate) params: Option<ParameterSet>,
+
+    /// Compare on the scenario instance drawn with seed N (as `run --seed N`); without it the
+    /// nominal scenario.
+    #[arg(long, value_name = "N")]
+    pub(crate) seed: Option<u64>,
+    /// Write the JSON summaries (an array) here.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) json: Option<PathBuf>,
+    /// Write figures into this existing folder: paths.png (both vehicles' paths per planner,
+    /// the paper's Fig. 3), states_<vehicle>.png (sideslip, yaw, yaw rate, speed over time per
+    /// planner; states_obstacle.png is the paper's Fig. 4) and time_series.csv (their data).
+    #[arg(long, value_name = "DIR")]
+    pub(crate) plots: Option<PathBuf>,
+}
+
+#[derive(Copy, Clone, Debug, ValueEnum)]
+pub(crate) enum ManeuverName {
+    /// Hold --speed-mps with the speed PID at fixed --steer-rad; report the settled state.
+    SteadyState,
+    /// Step the steering to --steer-rad at --speed-mps; report the response.
+    StepSteer,
+    /// Full braking from --speed-mps to standstill; report the stopping distance.
+    Braking,
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct ManeuverArgs {
+    /// Which test.
+    pub(crate) maneuver: ManeuverName,
+    /// Vehicle preset: bmw_320i, ford_escort, vw_vanagon.
+    #[arg(long, default_value = "bmw_320i")]
+    pub(crate) vehicle: String,
+    /// Tire–road friction coefficient μ (> 0).
+    #[arg(long, default_value_t = 0.8, allow_negative_numbers = true)]
+    pub(crate) mu: f64,
+    /// Speed (m/s).
+    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
+    pub(crate) speed_mps: f64,
+    /// Front wheel steering angle (rad).
+    #[arg(long, default_value_t = 0.02, allow_negative_numbers = true)]
+    pub(crate) steer_rad: f64,
+    /// Physics step (s).
+    #[arg(long, default_value_t = 0.002, allow_negative_numbers = true)]
+    pub(crate) dt_s: f64,
+    /// Write the report as JSON here.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) json: Option<PathBuf>,
+}
+
+#[derive(Subcommand, Debug)]
+pub(crate) enum ScenarioCommand {
+    /// List the built-in scenarios.
+    List,
+    /// Print a built-in scenario as TOML (which `--scenario PATH` reads back unchanged).
+    Show {
+        /// Built-in name.
+        name: String,
+    },
+}
+
+pub(crate) fn parse_planner(text: &str) -> Result<PlannerKind, String> {
+    text.parse::<PlannerKind>().map_err(|e| e.to_string())
+}
+
+pub(crate) fn parse_params(text: &str) -> Result<ParameterSet, String> {
+    text.parse::<ParameterSet>().map_err(|e| e.to_string())
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct SweepArgs {
+    /// Built-in scenario name or path to a scenario TOML file.
+    #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
+    pub(crate) scenario: String,
+    /// Planner of every planner-driven vehicle (overrides the scenario's choice).
+    #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
+    pub(crate) planner: Option<PlannerKind>,
+    /// Planner parameter set: `paper` (the paper's literal reading) or `mergesim` (our
+    /// improvements) [default: the scenario's `params`, else mergesim]. The scenario's
+    /// [sim.planner] values apply on top of it.
+    #[arg(long, value_name = "SET", value_parser = parse_params)]
+    pub(crate) params: Option<ParameterSet>,
+    /// Number of randomised instances in the whole sweep (at least 1).
+    #[arg(long, value_name = "N", value_parser = parse_runs)]
+    pub(crate) runs: u64,
+    /// Sweep seed K: instance i runs with seed SplitMix64::derive(K, i), which `run --seed`
+    /// replays.
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub(crate) seed: u64,
+    /// Run only shard i of n (0-based): instances [⌊i·N/n⌋, ⌊(i+1)·N/n⌋). Default: from a Slurm
+    /// job array (SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_COUNT), a Kubernetes Indexed Job
+    /// (JOB_COMPLETION_INDEX with MERGESIM_SHARD_COUNT), else the whole sweep (0/1).
+    #[arg(long, value_name = "i/n", value_parser = parse_shard)]
+    pub(crate) shard: Option<mergesim::sweep::Shard>,
+    /// Write the aggregate JSON here (with per-run samples, so shards can be merged).
+    #[arg(long, value_name = "PATH")]
+    pub(crate) json: Option<PathBuf>,
+    /// Write one JSON line per run here (instance, seed, status, figures, wall time).
+    #[arg(long, value_name = "PATH")]
+    pub(crate) jsonl: Option<PathBuf>,
+    /// Worker threads [default: one per core].
+    #[arg(long, value_name = "N", value_parser = parse_threads)]
+    pub(crate) threads: Option<usize>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct MergeResultsArgs {
+    /// The `sweep --json` files of every shard of one sweep, in any order.
+    #[arg(required = true, value_name = "SHARD_JSON")]
+    pub(crate) inputs: Vec<PathBuf>,
+    /// Write the aggregate of the whole sweep here.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) json: Option<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct GridArgs {
+    /// Built-in scenario name or path to a scenario TOML file.
+    #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
+    pub(crate) scenario: String,
+    /// Base parameter set of every cell (the four grid parameters are set on top of it).
+    #[arg(long, value_name = "SET", value_parser = parse_params)]
+    pub(crate) params: Option<ParameterSet>,
+    /// Planners, comma-separated; the first is the reference of the paired differences.
+    #[arg(long, value_delimiter = ',', value_parser = parse_planner,
+          default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
+    pub(crate) planners: Vec<PlannerKind>,
+    /// Path-field time gaps τ (s), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "0,1,2,3", value_parser = parse_gap)]
+    pub(crate) path_gaps: Vec<f64>,
+    /// Interaction time gaps τ_I (s), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,2,3", value_parser = parse_gap)]
+    pub(crate) interaction_gaps: Vec<f64>,
+    /// Run only the parameter set's own cell (its prediction, sub-steps, τ and τ_I): a paired
+    /// study of the planners as configured, with a table of paired differences for every
+    /// vehicle and figure.
+    #[arg(long, conflicts_with_all = ["path_gaps", "interaction_gaps"])]
+    pub(crate) base_only: bool,
+    /// Instances per cell: 0 runs the nominal scenario only; N runs the instances a sweep
+    /// with --seed would (instance i with seed SplitMix64::derive(seed, i)).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub(crate) runs: u64,
+    /// Sweep seed of the drawn instances.
+    #[arg(long, default_value_t = 0, value_name = "K")]
+    pub(crate) seed: u64,
+    /// Vehicle whose figures the table and the figure compare.
+    #[arg(long, default_value = "obstacle", value_name = "NAME")]
+    pub(crate) vehicle: String,
+    /// Write every run (one line per run and vehicle) here.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) csv: Option<PathBuf>,
+    /// Write the runs and the paired differences as JSON here.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) json: Option<PathBuf>,
+    /// Write the figure (heat maps of the mean ratio of the vehicle's peak yaw rate to the
+    /// first planner's) here.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) plot: Option<PathBuf>,
+    /// Worker threads [default: one per core].
+    #[arg(long, value_name = "N", value_parser = parse_threads)]
+    pub(crate) threads: Option<usize>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+pub(crate) fn parse_runs(text: &str) -> Result<u64, String> {
+    match text.parse::<u64>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(n) => Ok(n),
+        Err(_) => Err("expected a whole number of runs, at least 1".into()),
+    }
+}
+
+pub(crate) fn parse_threads(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(0) | Err(_) => Err("expected a whole number of threads, at least 1".into()),
+        Ok(n) => Ok(n),
+    }
+}
+
+pub(crate) fn parse_shard(text: &str) -> Result<mergesim::sweep::Shard, String> {
+    text.parse()
+        .map_err(|e: mergesim::sweep::ShardError| e.to_string())
+}
+
+pub(crate) fn parse_gap(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() && (0.0..=10.0).contains(&v) => Ok(v),
+        _ => Err("expected a time gap in [0, 10] s".into()),
+    }
+}

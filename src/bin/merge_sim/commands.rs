@@ -1,0 +1,386 @@
+//! The subcommands: each parses nothing and prints or writes what the library returns.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use anyhow::{Context, anyhow};
+use mergesim::output::{check_output_path, write_atomically};
+use mergesim::report::{comparison_table, grid_table, study_table, time_series_csv};
+use scenarios::Scenario;
+use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
+
+use crate::args::{
+    CompareArgs, GridArgs, ManeuverArgs, ManeuverName, MergeResultsArgs, RunArgs, ScenarioCommand,
+    SweepArgs,
+};
+use crate::{
+    Failure, input, load_scenario, out, outln, run_failure, simulate, sweep_failure, write_output,
+};
+
+pub(crate) fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
+    let scenario = load_scenario(&args.scenario, args.params)?;
+    let label = mergesim::sweep::planner_label(&scenario, args.planner);
+    let rrd = if args.no_rrd {
+        None
+    } else {
+        Some(
+            args.rrd
+                .clone()
+                .unwrap_or_else(|| PathBuf::from(format!("{}_{label}.rrd", scenario.name))),
+        )
+    };
+    for (path, what) in [
+        (rrd.as_deref(), "--rrd"),
+        (args.json.as_deref(), "--json"),
+        (args.csv.as_deref(), "--csv"),
+    ] {
+        if let Some(path) = path {
+            check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
+        }
+    }
+    let show_progress = !args.quiet && std::io::stderr().is_terminal();
+    let finished = simulate(
+        &scenario,
+        args.planner,
+        args.seed,
+        rrd.as_deref(),
+        args.csv.is_some(),
+        show_progress,
+    )?;
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&finished.summary).map_err(run_failure)?;
+        write_atomically(path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))
+            .map_err(run_failure)?;
+    }
+    if let Some(path) = &args.csv {
+        let text = time_series_csv(&finished.outcome.time_series);
+        write_atomically(path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))
+            .map_err(run_failure)?;
+    }
+    if !args.quiet {
+        out!("{}", finished.summary.table());
+        for event in &finished.summary.events {
+            outln!("event: {event}");
+        }
+        if let Some(path) = &rrd {
+            outln!(
+                "recording: {} (open with `rerun {}`)",
+                path.display(),
+                path.display()
+            );
+        }
+    }
+    if args.view
+        && let Some(path) = &rrd
+    {
+        std::process::Command::new("rerun")
+            .arg(path)
+            .spawn()
+            .context(
+                "cannot start the Rerun viewer `rerun` (install: pip install rerun-sdk==0.36.3)",
+            )
+            .map_err(run_failure)?;
+    }
+    Ok(())
+}
+
+pub(crate) fn cmd_compare(args: &CompareArgs) -> Result<(), Failure> {
+    let scenario = load_scenario(&args.scenario, args.params)?;
+    if let Some(path) = &args.json {
+        check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
+    }
+    if let Some(dir) = &args.plots {
+        mergesim::plots::check_plot_dir(dir).map_err(|e| input(anyhow!(e)))?;
+    }
+    let show_progress = std::io::stderr().is_terminal();
+    let mut summaries = Vec::new();
+    let mut time_series = Vec::new();
+    for &kind in &args.planners {
+        let finished = simulate(
+            &scenario,
+            Some(kind),
+            args.seed,
+            None,
+            args.plots.is_some(),
+            show_progress,
+        )?;
+        summaries.push(finished.summary);
+        time_series.push(finished.outcome.time_series);
+    }
+    out!("{}", comparison_table(&summaries));
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&summaries).map_err(run_failure)?;
+        write_atomically(path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))
+            .map_err(run_failure)?;
+    }
+    if let Some(dir) = &args.plots {
+        let series: Vec<mergesim::plots::PlannerSeries<'_>> = summaries
+            .iter()
+            .zip(&time_series)
+            .map(|(s, rows)| mergesim::plots::PlannerSeries {
+                planner: &s.planner,
+                rows,
+            })
+            .collect();
+        let road = &scenario.instance(args.seed).sim.road;
+        let written = mergesim::plots::write_comparison(
+            dir,
+            road,
+            &series,
+            mergesim::plots::FigureSize::default(),
+        )
+        .map_err(run_failure)?;
+        for path in written {
+            outln!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn cmd_maneuver(args: &ManeuverArgs) -> Result<(), Failure> {
+    if let Some(path) = &args.json {
+        check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
+    }
+    let kind = match args.maneuver {
+        ManeuverName::SteadyState => ManeuverKind::SteadyState,
+        ManeuverName::StepSteer => ManeuverKind::StepSteer,
+        ManeuverName::Braking => ManeuverKind::Braking,
+    };
+    let config = ManeuverConfig {
+        kind,
+        vehicle: args.vehicle.clone(),
+        speed_mps: args.speed_mps,
+        steer_rad: args.steer_rad,
+        mu: args.mu,
+        dt_s: args.dt_s,
+        ..ManeuverConfig::default()
+    };
+    config.validate().map_err(input)?;
+    let report = run_maneuver(&config).map_err(run_failure)?;
+    let text = serde_json::to_string_pretty(&report).map_err(run_failure)?;
+    if let Some(path) = &args.json {
+        write_atomically(path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))
+            .map_err(run_failure)?;
+    }
+    outln!("{text}");
+    Ok(())
+}
+
+pub(crate) fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
+    match cmd {
+        ScenarioCommand::List => {
+            for name in scenarios::builtin::names() {
+                let scenario = Scenario::load(name).map_err(run_failure)?;
+                outln!("{name:<20} {}", scenario.description);
+            }
+        }
+        ScenarioCommand::Show { name } => {
+            let text = scenarios::builtin::toml_of(name).ok_or_else(|| {
+                input(anyhow!(
+                    "unknown built-in scenario {name:?} (built-ins: {})",
+                    scenarios::builtin::names().join(", ")
+                ))
+            })?;
+            out!("{text}");
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn cmd_sweep(args: &SweepArgs) -> Result<(), Failure> {
+    use mergesim::sweep::{Shard, SweepOptions, SweepPlan, run_sweep};
+    let scenario = load_scenario(&args.scenario, args.params)?;
+    for (path, what) in [
+        (args.json.as_deref(), "--json"),
+        (args.jsonl.as_deref(), "--jsonl"),
+    ] {
+        if let Some(path) = path {
+            check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
+        }
+    }
+    let shard = match args.shard {
+        Some(shard) => shard,
+        None => Shard::from_environment(|name| std::env::var(name).ok())
+            .map_err(input)?
+            .unwrap_or(Shard::WHOLE),
+    };
+    let plan = SweepPlan {
+        scenario,
+        planner: args.planner,
+        runs: args.runs,
+        seed: args.seed,
+        shard,
+    };
+    let instances = shard.instances(args.runs);
+    let bar = if !args.quiet && std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(instances.end - instances.start);
+        let style = indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:30}] {pos}/{len} runs, {per_sec}, ETA {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+        bar.set_style(style);
+        bar.set_message(format!("sweep {} shard {shard}", plan.scenario.name));
+        bar
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let options = SweepOptions {
+        threads: args.threads,
+    };
+    let outcome = run_sweep(&plan, &options, &|| bar.inc(1)).map_err(sweep_failure)?;
+    bar.finish_and_clear();
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&outcome.summary).map_err(run_failure)?;
+        write_output(path, &text)?;
+    }
+    if let Some(path) = &args.jsonl {
+        let text = outcome
+            .summary
+            .jsonl(&outcome.run_wall_times_s)
+            .map_err(run_failure)?;
+        write_output(path, &text)?;
+    }
+    if !args.quiet {
+        out!("{}", outcome.summary.table());
+        for row in outcome.summary.samples.iter().filter(|r| r.error.is_some()) {
+            outln!(
+                "run {} (seed {}) {:?}: {}",
+                row.instance,
+                row.seed,
+                row.status,
+                row.error.as_deref().unwrap_or_default()
+            );
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> {
+    use mergesim::sweep::{SweepSummary, merge_shards};
+    if let Some(path) = &args.json {
+        check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
+    }
+    let mut parts = Vec::with_capacity(args.inputs.len());
+    for path in &args.inputs {
+        let origin = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {origin}"))
+            .map_err(input)?;
+        let part: SweepSummary = serde_json::from_str(&text)
+            .with_context(|| format!("{origin}: not a `merge_sim sweep --json` file"))
+            .map_err(input)?;
+        parts.push((origin, part));
+    }
+    let merged = merge_shards(parts).map_err(sweep_failure)?;
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&merged).map_err(run_failure)?;
+        write_output(path, &text)?;
+    }
+    if !args.quiet {
+        out!("{}", merged.table());
+    }
+    Ok(())
+}
+
+/// Most instances a grid cell may run (the default grid runs 36 cells × planners of them).
+const MAX_GRID_RUNS: u64 = 10_000;
+
+pub(crate) fn cmd_grid(args: &GridArgs) -> Result<(), Failure> {
+    use mergesim::grid::{GridAxes, GridMetric, GridPlan, job_count, run_grid};
+    let scenario = load_scenario(&args.scenario, args.params)?;
+    if !scenario.vehicles.iter().any(|v| v.name == args.vehicle) {
+        return Err(input(anyhow!(
+            "--vehicle {:?}: no such vehicle in scenario {} (vehicles: {})",
+            args.vehicle,
+            scenario.name,
+            scenario
+                .vehicles
+                .iter()
+                .map(|v| v.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
+    if args.runs > MAX_GRID_RUNS {
+        return Err(input(anyhow!(
+            "--runs {}: at most {MAX_GRID_RUNS} instances per cell",
+            args.runs
+        )));
+    }
+    for (path, what) in [
+        (args.csv.as_deref(), "--csv"),
+        (args.json.as_deref(), "--json"),
+        (args.plot.as_deref(), "--plot"),
+    ] {
+        if let Some(path) = path {
+            check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
+        }
+    }
+    if args.plot.is_some() && args.planners.len() < 2 {
+        return Err(input(anyhow!(
+            "--plot: the figure compares planners with the first; give at least two"
+        )));
+    }
+    let axes = if args.base_only {
+        GridAxes::of_params(&scenario.sim.planner)
+    } else {
+        GridAxes {
+            path_time_gap_s: args.path_gaps.clone(),
+            interaction_time_gap_s: args.interaction_gaps.clone(),
+            ..GridAxes::default()
+        }
+    };
+    let plan = GridPlan {
+        axes,
+        scenario,
+        planners: args.planners.clone(),
+        runs: args.runs,
+        seed: args.seed,
+        threads: args.threads,
+    };
+    let bar = if !args.quiet && std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(job_count(&plan));
+        let style = indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:30}] {pos}/{len} runs, {per_sec}, ETA {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+        bar.set_style(style);
+        bar.set_message(format!("grid {}", plan.scenario.name));
+        bar
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let outcome = run_grid(&plan, &|| bar.inc(1)).map_err(|e| run_failure(anyhow!(e)))?;
+    bar.finish_and_clear();
+    let peak = outcome.paired_differences(&args.vehicle, GridMetric::PeakYawRate);
+    let zone = outcome.paired_differences(&args.vehicle, GridMetric::MergeZoneRmsYawRate);
+    if let Some(path) = &args.csv {
+        write_output(path, &outcome.csv())?;
+    }
+    if let Some(path) = &args.json {
+        let value = serde_json::json!({
+            "grid": &outcome,
+            "vehicle": &args.vehicle,
+            "paired_peak_yaw_rate": &peak,
+            "paired_merge_zone_rms_yaw_rate": &zone,
+        });
+        let text = serde_json::to_string_pretty(&value).map_err(run_failure)?;
+        write_output(path, &text)?;
+    }
+    if let Some(path) = &args.plot {
+        mergesim::grid_plot::write_grid_png(path, &outcome, &args.vehicle, GridMetric::PeakYawRate)
+            .map_err(run_failure)?;
+    }
+    if !args.quiet {
+        out!("{}", grid_table(&outcome, &args.vehicle));
+        if outcome.axes.cells().len() == 1 {
+            out!("{}", study_table(&outcome));
+        }
+        outln!("wall time {:.1} s", outcome.wall_time_s);
+    }
+    Ok(())
+}

@@ -1,0 +1,165 @@
+//! `merge_sim`: run, compare and inspect cooperative merge simulations.
+//!
+//! Exit codes: 0 success, 1 the simulation or an output failed, 2 bad input (arguments,
+//! scenario values, presets) — reported with the offending value, before anything is written.
+//!
+//! This binary only parses the command line ([`args`]), calls the library
+//! (`mergesim::experiment::run_instance`, `mergesim::sweep`, `mergesim::grid`, …) and prints
+//! or writes what it returns ([`commands`]).
+
+mod args;
+mod commands;
+
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::Parser;
+use mergesim::experiment::{Finished, InstanceOptions, RunError, planner_label, run_instance};
+use mergesim::output::write_atomically;
+use planner::{ParameterSet, PlannerKind};
+use scenarios::Scenario;
+use sim::BehaviourRegistry;
+use sim::recording::Recorder;
+
+use crate::args::{Cli, Command};
+
+/// `print!` that ends the process quietly when stdout is closed (output piped into `head`)
+/// instead of panicking.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = write!(std::io::stdout(), $($arg)*) {
+            if e.kind() == std::io::ErrorKind::BrokenPipe {
+                std::process::exit(0);
+            }
+        }
+    }};
+}
+
+/// `println!` with the same treatment of a closed stdout as [`out!`].
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        out!($($arg)*);
+        out!("\n");
+    }};
+}
+
+pub(crate) use {out, outln};
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => commands::cmd_run(&cli.run),
+        Some(Command::Run(args)) => commands::cmd_run(&args),
+        Some(Command::Compare(args)) => commands::cmd_compare(&args),
+        Some(Command::Maneuver(args)) => commands::cmd_maneuver(&args),
+        Some(Command::Scenario(cmd)) => commands::cmd_scenario(&cmd),
+        Some(Command::Sweep(args)) => commands::cmd_sweep(&args),
+        Some(Command::MergeResults(args)) => commands::cmd_merge_results(&args),
+        Some(Command::Grid(args)) => commands::cmd_grid(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Input(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Run(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// An error with its exit code: 2 for bad input, 1 for failures while running.
+pub(crate) enum Failure {
+    Input(anyhow::Error),
+    Run(anyhow::Error),
+}
+
+pub(crate) fn input<E: Into<anyhow::Error>>(e: E) -> Failure {
+    Failure::Input(e.into())
+}
+
+pub(crate) fn run_failure<E: Into<anyhow::Error>>(e: E) -> Failure {
+    Failure::Run(e.into())
+}
+
+/// Loads a scenario and switches it to `params` if given.
+pub(crate) fn load_scenario(
+    name_or_path: &str,
+    params: Option<ParameterSet>,
+) -> Result<Scenario, Failure> {
+    let scenario = Scenario::load(name_or_path).map_err(input)?;
+    match params {
+        Some(set) => scenario.with_parameter_set(set).map_err(input),
+        None => Ok(scenario),
+    }
+}
+
+fn progress_printer(enabled: bool, label: String) -> impl FnMut(f64) {
+    let mut last = -1i64;
+    move |fraction: f64| {
+        if !enabled {
+            return;
+        }
+        let percent = (fraction * 100.0).floor() as i64;
+        if percent != last {
+            last = percent;
+            eprint!("\r{label}: {percent:3}%");
+            if percent >= 100 {
+                eprintln!();
+            }
+        }
+    }
+}
+
+/// Runs one instance of `scenario` (the library's `run_instance`), with a progress line on a
+/// terminal: a scenario the world refuses is bad input, a failure while running is not.
+pub(crate) fn simulate(
+    scenario: &Scenario,
+    planner: Option<PlannerKind>,
+    seed: Option<u64>,
+    rrd: Option<&std::path::Path>,
+    keep_time_series: bool,
+    show_progress: bool,
+) -> Result<Finished, Failure> {
+    let planner = planner.map(|k| k.name().to_string());
+    let label = planner_label(scenario, planner.as_deref());
+    let recorder = match rrd {
+        Some(path) => Recorder::new_file(path, "mergesim")
+            .with_context(|| format!("cannot create recording {}", path.display()))
+            .map_err(run_failure)?,
+        None => Recorder::disabled(),
+    };
+    let options = InstanceOptions {
+        planner,
+        seed,
+        keep_time_series,
+    };
+    let progress = progress_printer(show_progress, format!("{} {label}", scenario.name));
+    run_instance(
+        scenario,
+        &options,
+        recorder,
+        &BehaviourRegistry::builtin(),
+        progress,
+    )
+    .map_err(|e| match e {
+        RunError::Setup(e) => input(e),
+        RunError::Run(e) => run_failure(e),
+    })
+}
+
+pub(crate) fn write_output(path: &std::path::Path, text: &str) -> Result<(), Failure> {
+    write_atomically(path, text.as_bytes())
+        .with_context(|| format!("cannot write {}", path.display()))
+        .map_err(run_failure)
+}
+
+pub(crate) fn sweep_failure(e: mergesim::sweep::SweepError) -> Failure {
+    match e {
+        mergesim::sweep::SweepError::Invalid(_) => input(e),
+        mergesim::sweep::SweepError::Threads(_) => run_failure(e),
+    }
+}

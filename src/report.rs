@@ -1,0 +1,208 @@
+//! Text reports of runs, comparisons and grids, as the command line prints them.
+
+use sim::TimeSeriesRow;
+
+use crate::grid::{GridMetric, GridOutcome, PairedDifference};
+use crate::summary::RunSummary;
+
+/// The `--csv` time series: a header and one line per vehicle per logged instant.
+pub fn time_series_csv(rows: &[TimeSeriesRow]) -> String {
+    let mut text = String::from(TimeSeriesRow::CSV_HEADER);
+    text.push('\n');
+    for row in rows {
+        text.push_str(&row.csv_line());
+        text.push('\n');
+    }
+    text
+}
+
+/// The side-by-side table of `merge_sim compare`: the safety figures, then every vehicle's
+/// motion states and the paper's figures, one column per run.
+pub fn comparison_table(summaries: &[RunSummary]) -> String {
+    let mut out = String::new();
+    out.push_str(&format!("{:<28}", "metric"));
+    for s in summaries {
+        out.push_str(&format!("{:>13}", s.planner));
+    }
+    out.push('\n');
+    let mut row = |label: &str, value: &dyn Fn(&RunSummary) -> String| {
+        out.push_str(&format!("{label:<28}"));
+        for s in summaries {
+            out.push_str(&format!("{:>13}", value(s)));
+        }
+        out.push('\n');
+    };
+    row("collisions", &|s| s.collisions.to_string());
+    row("min gap m", &|s| {
+        s.min_gap_m
+            .map(|g| format!("{g:.2}"))
+            .unwrap_or_else(|| "-".into())
+    });
+    row("min TTC s", &|s| {
+        s.min_ttc_s
+            .map(|t| format!("{t:.2}"))
+            .unwrap_or_else(|| "-".into())
+    });
+    row("near miss", &|s| s.near_miss.to_string());
+    row("fallbacks", &|s| s.planner_stats.fallbacks.to_string());
+    let names: Vec<String> = summaries
+        .first()
+        .map(|s| s.vehicles.iter().map(|v| v.id.clone()).collect())
+        .unwrap_or_default();
+    for (i, name) in names.iter().enumerate() {
+        let get = |s: &RunSummary| s.vehicles.get(i).cloned();
+        row(&format!("{name} |β|max rad"), &|s| {
+            get(s)
+                .map(|v| format!("{:.4}", v.max_abs_sideslip_rad))
+                .unwrap_or_default()
+        });
+        row(&format!("{name} |ψ|max rad"), &|s| {
+            get(s)
+                .map(|v| format!("{:.4}", v.max_abs_yaw_rad))
+                .unwrap_or_default()
+        });
+        row(&format!("{name} |r|max rad/s"), &|s| {
+            get(s)
+                .map(|v| format!("{:.4}", v.max_abs_yaw_rate_radps))
+                .unwrap_or_default()
+        });
+        row(&format!("{name} v_min m/s"), &|s| {
+            get(s)
+                .map(|v| format!("{:.2}", v.min_speed_mps))
+                .unwrap_or_default()
+        });
+        row(&format!("{name} path m"), &|s| {
+            get(s)
+                .map(|v| format!("{:.1}", v.path_length_m))
+                .unwrap_or_default()
+        });
+        row(&format!("{name} r sign changes"), &|s| {
+            get(s)
+                .map(|v| v.yaw_rate_sign_changes.to_string())
+                .unwrap_or_default()
+        });
+        let paper = |s: &RunSummary| get(s).and_then(|v| v.paper_metrics);
+        let opt = |value: Option<f64>, digits: usize| {
+            value
+                .map(|x| format!("{x:.digits$}"))
+                .unwrap_or_else(|| "-".into())
+        };
+        row(&format!("{name} slowing onset s"), &|s| {
+            opt(paper(s).and_then(|p| p.slowing_onset_s), 2)
+        });
+        row(&format!("{name} RMS r merge zone"), &|s| {
+            opt(paper(s).and_then(|p| p.merge_zone_rms_yaw_rate_radps), 4)
+        });
+        row(&format!("{name} RMS r outside"), &|s| {
+            opt(
+                paper(s).and_then(|p| p.outside_merge_zone_rms_yaw_rate_radps),
+                4,
+            )
+        });
+        row(&format!("{name} max lane offset m"), &|s| {
+            opt(paper(s).map(|p| p.max_abs_lane_offset_m), 2)
+        });
+        row(&format!("{name} crosses divider x m"), &|s| {
+            opt(paper(s).and_then(|p| p.divider_crossing).map(|c| c.x_m), 1)
+        });
+    }
+    out
+}
+
+/// The grid's table: per cell and planner, the mean of its peak yaw rate and of its merge-zone
+/// yaw-rate RMS of `vehicle` over the reference planner's, and the collisions of both.
+pub fn grid_table(outcome: &GridOutcome, vehicle: &str) -> String {
+    let peak = outcome.paired_differences(vehicle, GridMetric::PeakYawRate);
+    let zone = outcome.paired_differences(vehicle, GridMetric::MergeZoneRmsYawRate);
+    let mut out = format!(
+        "grid {} ({} set), {} instance(s) per cell, vehicle {vehicle}: mean of each planner / mean of {} \
+         (peak |r|; RMS r in the merge zone), collisions\n",
+        outcome.scenario,
+        outcome.params,
+        outcome.runs.max(1),
+        outcome.planners.first().map(String::as_str).unwrap_or("-")
+    );
+    let ratio = |d: &PairedDifference| match (d.mean, d.reference_mean) {
+        (Some(a), Some(b)) if b > 0.0 => format!("{:.2}", a / b),
+        _ => "-".into(),
+    };
+    for (p, z) in peak.iter().zip(&zone) {
+        out.push_str(&format!(
+            "{:<22} {:<12} peak {:>5}  zone {:>5}  collisions {} ({} {})\n",
+            p.cell.label(),
+            p.planner,
+            ratio(p),
+            ratio(z),
+            p.collisions,
+            p.reference,
+            p.reference_collisions
+        ));
+    }
+    out
+}
+
+/// Paired differences of every planner against the first, for every vehicle and figure, and
+/// the collisions of each planner (a single-cell grid).
+pub fn study_table(outcome: &GridOutcome) -> String {
+    let mut out = String::new();
+    let vehicles: Vec<String> = outcome
+        .rows
+        .iter()
+        .flat_map(|r| r.vehicles.iter().map(|v| v.vehicle.clone()))
+        .fold(Vec::new(), |mut acc, v| {
+            if !acc.contains(&v) {
+                acc.push(v);
+            }
+            acc
+        });
+    let reference = &outcome.planners[0];
+    out.push_str(&format!(
+        "paired differences against {reference} (mean ± standard error; n: pairs; lower: \
+         instances where the planner's value is lower)\n"
+    ));
+    for planner in &outcome.planners {
+        let rows: Vec<_> = outcome
+            .rows
+            .iter()
+            .filter(|r| &r.planner == planner)
+            .collect();
+        let collisions: u64 = rows.iter().map(|r| r.collisions.unwrap_or(0)).sum();
+        let colliding_runs = rows
+            .iter()
+            .filter(|r| r.collisions.unwrap_or(0) > 0)
+            .count();
+        let failed = rows.iter().filter(|r| r.error.is_some()).count();
+        out.push_str(&format!(
+            "{planner:<12} collisions {collisions} in {colliding_runs} of {} runs{}\n",
+            rows.len(),
+            if failed > 0 {
+                format!(", {failed} failed")
+            } else {
+                String::new()
+            }
+        ));
+    }
+    for vehicle in &vehicles {
+        for metric in GridMetric::ALL {
+            for d in outcome.paired_differences(vehicle, metric) {
+                let digits = metric.decimals();
+                let fmt = |v: Option<f64>| {
+                    v.map(|x| format!("{x:.digits$}"))
+                        .unwrap_or_else(|| "-".into())
+                };
+                out.push_str(&format!(
+                    "{vehicle:<10} {:<26} {:<12} {:>9} vs {:>9}  diff {:>9} ± {:<7} n {:>3} lower {:>3}\n",
+                    metric.label(),
+                    d.planner,
+                    fmt(d.mean),
+                    fmt(d.reference_mean),
+                    fmt(d.mean_difference),
+                    fmt(d.standard_error),
+                    d.pairs,
+                    d.lower
+                ));
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,98 @@
+//! The extension point: how a vehicle decides its path and speed. A planner — the paper's
+//! potential-field planners, a human-driver model, or a user's own — implements [`Behaviour`]:
+//! an [`Observation`] in, a [`Decision`] (the path to track, with speeds and times, and the
+//! message to broadcast) out. The simulator calls it at every planning period of the vehicle,
+//! visiting the vehicles in id order.
+//!
+//! ```
+//! use mergesim_types::{Behaviour, BehaviourError, Decision, Observation, PathPoint};
+//!
+//! /// Drives straight ahead at its target speed (a user's planner in ten lines).
+//! struct Straight;
+//!
+//! impl Behaviour for Straight {
+//!     fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError> {
+//!         let v = obs.target_speed_mps.max(0.5);
+//!         let path = (0..=20)
+//!             .map(|i| PathPoint {
+//!                 x_m: obs.ego.x_m + 2.0 * i as f64,
+//!                 y_m: obs.ego.y_m,
+//!                 speed_mps: v,
+//!                 t_s: obs.time_s + 2.0 * i as f64 / v,
+//!             })
+//!             .collect();
+//!         Ok(Decision::follow(path))
+//!     }
+//! }
+//! ```
+
+use crate::grid::GridSpec;
+use crate::path::{PathPoint, SharedLocalPath};
+use crate::road::MergeRoad;
+use crate::vehicle::{Neighbour, VehicleId, VehicleShape, VehicleState};
+
+/// Why a behaviour could not plan (its own error, boxed).
+pub type BehaviourError = Box<dyn std::error::Error + Send + Sync + 'static>;
+
+/// What a vehicle's driver knows at a planning instant.
+#[derive(Clone, Copy, Debug)]
+pub struct Observation<'a> {
+    /// Planning time (s).
+    pub time_s: f64,
+    /// The vehicle's id.
+    pub ego_id: VehicleId,
+    /// Its state.
+    pub ego: VehicleState,
+    /// Its footprint and braking.
+    pub ego_shape: VehicleShape,
+    /// Its target speed V_target (m/s).
+    pub target_speed_mps: f64,
+    /// Tire–road friction μ.
+    pub mu: f64,
+    /// The road.
+    pub road: &'a MergeRoad,
+    /// Every other vehicle's current state (perception), in id order.
+    pub neighbours: &'a [Neighbour],
+    /// The shared local paths received over V2V (empty for a vehicle that is not connected).
+    pub shared_paths: &'a [SharedLocalPath],
+}
+
+/// What a behaviour decides.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Decision {
+    /// The path to track: points with speeds and absolute times, starting at the vehicle.
+    pub path: Vec<PathPoint>,
+    /// The message to broadcast (sent only if the vehicle is connected).
+    pub broadcast: Option<SharedLocalPath>,
+    /// Why this decision is a fallback (logged and counted), if it is one.
+    pub fallback: Option<String>,
+}
+
+impl Decision {
+    /// Follow `path`, broadcast nothing.
+    pub fn follow(path: Vec<PathPoint>) -> Self {
+        Self {
+            path,
+            broadcast: None,
+            fallback: None,
+        }
+    }
+}
+
+/// A vehicle's decision making (module doc). `Send` so the simulator may plan vehicles in
+/// parallel.
+pub trait Behaviour: Send {
+    /// One planning cycle.
+    fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError>;
+
+    /// Whether its cycles count as planner cycles in the run's statistics (timing, fallbacks).
+    /// Human-driver models answer `false`.
+    fn is_planner(&self) -> bool {
+        true
+    }
+
+    /// Its potential field on `spec`'s grid, row after row, for drawing; `None` if it has none.
+    fn potential_field(&self, _obs: &Observation<'_>, _spec: &GridSpec) -> Option<Vec<f64>> {
+        None
+    }
+}
