@@ -20,6 +20,12 @@ use sim::TimeSeriesRow;
 
 use crate::output::{temporary_path, write_atomically};
 
+mod motion_states;
+mod paths;
+
+use motion_states::draw_states;
+use paths::draw_paths;
+
 /// The embedded font (DejaVu Sans Mono).
 const FONT_TTF: &[u8] = include_bytes!("../docs/fonts/DejaVuSansMono.ttf");
 
@@ -287,184 +293,6 @@ fn padded_range(values: impl Iterator<Item = f64>, margin: f64, min_span: f64) -
     let mid = 0.5 * (lo + hi);
     let half = 0.5 * span * (1.0 + 2.0 * margin);
     (mid - half)..(mid + half)
-}
-
-/// Fig. 3: the road (edges, divider, merge section shaded) and each vehicle's path, one panel
-/// per planner; the first vehicle solid, the others dashed.
-fn draw_paths(
-    area: &DrawingArea<BitMapBackend<'_>, Shift>,
-    road: &MergeRoad,
-    series: &[PlannerSeries<'_>],
-    vehicles: &[String],
-) -> DrawResult {
-    let x_range = padded_range(
-        series.iter().flat_map(|s| s.rows.iter().map(|r| r.x_m)),
-        0.01,
-        10.0,
-    );
-    let y_range = (road.y_bottom_m - 0.5)..(road.y_upper_m() + 0.5);
-    let panels = area.split_evenly((series.len(), 1));
-    for (panel, s) in panels.iter().zip(series) {
-        let mut chart = ChartBuilder::on(panel)
-            .caption(format!("{}: paths", s.planner), font(20))
-            .margin(8)
-            .x_label_area_size(34)
-            .y_label_area_size(56)
-            .build_cartesian_2d(x_range.clone(), y_range.clone())
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("x (m)")
-            .y_desc("y (m)")
-            .label_style(font(14))
-            .axis_desc_style(font(14))
-            .light_line_style(WHITE)
-            .draw()
-            .map_err(|e| e.to_string())?;
-        // Merge section, shaded as in the paper.
-        let merge = RGBColor(255, 200, 120).mix(0.35);
-        chart
-            .draw_series(std::iter::once(Rectangle::new(
-                [
-                    (road.merge_start_x_m, road.y_bottom_m),
-                    (road.merge_end_x_m, road.y_upper_m()),
-                ],
-                merge.filled(),
-            )))
-            .map_err(|e| e.to_string())?;
-        let edge = BLACK.stroke_width(2);
-        for line in [road.lower_edge_polyline(), road.upper_edge_polyline()] {
-            chart
-                .draw_series(LineSeries::new(
-                    line.into_iter().map(|p| (p[0], p[1])),
-                    edge,
-                ))
-                .map_err(|e| e.to_string())?;
-        }
-        let divider_end = road.merge_end_x_m.min(road.end_x_m);
-        chart
-            .draw_series(DashedLineSeries::new(
-                [
-                    (road.start_x_m, road.y_lane_m()),
-                    (divider_end, road.y_lane_m()),
-                ],
-                8,
-                6,
-                RGBColor(120, 120, 120).stroke_width(1),
-            ))
-            .map_err(|e| e.to_string())?;
-        for (k, vehicle) in vehicles.iter().enumerate() {
-            let color = if k == 0 {
-                RGBColor(120, 60, 160)
-            } else {
-                let c = Palette99::pick(k + 2).to_rgba();
-                RGBColor(c.0, c.1, c.2)
-            };
-            let points: Vec<(f64, f64)> = s
-                .rows
-                .iter()
-                .filter(|r| r.vehicle == *vehicle)
-                .map(|r| (r.x_m, r.y_m))
-                .collect();
-            let style = color.stroke_width(2);
-            let anchor = if k == 0 {
-                chart
-                    .draw_series(LineSeries::new(points, style))
-                    .map_err(|e| e.to_string())?
-            } else {
-                chart
-                    .draw_series(DashedLineSeries::new(points, 10, 5, style))
-                    .map_err(|e| e.to_string())?
-            };
-            anchor
-                .label(vehicle.clone())
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
-        }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
-    }
-    Ok(())
-}
-
-/// The legend box of one panel, in the same style on every figure.
-fn draw_legend<'a, DB, CT>(
-    chart: &mut ChartContext<'a, DB, CT>,
-    position: SeriesLabelPosition,
-) -> Result<(), String>
-where
-    DB: DrawingBackend + 'a,
-    DB::ErrorType: 'static,
-    CT: CoordTranslate,
-{
-    chart
-        .configure_series_labels()
-        .position(position)
-        .label_font(font(14))
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| e.to_string())
-}
-
-/// Fig. 4: sideslip, yaw, yaw rate and speed of `vehicle` over time, one line per planner.
-fn draw_states(
-    area: &DrawingArea<BitMapBackend<'_>, Shift>,
-    series: &[PlannerSeries<'_>],
-    vehicle: &str,
-) -> DrawResult {
-    type Getter = fn(&TimeSeriesRow) -> f64;
-    let quantities: [(&str, Getter, f64); 4] = [
-        ("sideslip β (rad)", |r| r.sideslip_rad, 0.002),
-        ("yaw ψ (rad)", |r| r.yaw_rad, 0.002),
-        ("yaw rate r (rad/s)", |r| r.yaw_rate_radps, 0.002),
-        ("speed v (m/s)", |r| r.speed_mps, 1.0),
-    ];
-    let t_range = padded_range(
-        series.iter().flat_map(|s| s.rows.iter().map(|r| r.t_s)),
-        0.0,
-        1.0,
-    );
-    let panels = area.split_evenly((quantities.len(), 1));
-    for (panel, (label, get, min_span)) in panels.iter().zip(quantities) {
-        let y_range = padded_range(
-            series
-                .iter()
-                .flat_map(|s| s.rows.iter().filter(|r| r.vehicle == vehicle).map(get)),
-            0.05,
-            min_span,
-        );
-        let mut chart = ChartBuilder::on(panel)
-            .caption(format!("{vehicle}: {label}"), font(18))
-            .margin(8)
-            .x_label_area_size(34)
-            .y_label_area_size(70)
-            .build_cartesian_2d(t_range.clone(), y_range)
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("t (s)")
-            .label_style(font(14))
-            .axis_desc_style(font(14))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        for (index, s) in series.iter().enumerate() {
-            let color = planner_color(s.planner, index);
-            let style = color.stroke_width(2);
-            let points: Vec<(f64, f64)> = s
-                .rows
-                .iter()
-                .filter(|r| r.vehicle == vehicle)
-                .map(|r| (r.t_s, get(r)))
-                .collect();
-            chart
-                .draw_series(LineSeries::new(points, style))
-                .map_err(|e| e.to_string())?
-                .label(s.planner.to_string())
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
-        }
-        draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
-    }
-    Ok(())
 }
 
 #[cfg(test)]

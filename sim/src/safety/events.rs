@@ -1,0 +1,155 @@
+//! What the safety checks report: collision and road-edge contact events, per-pair figures, the
+//! run's summary and each checked instant's report.
+
+use mergesim_types::VehicleId;
+use serde::{Deserialize, Serialize};
+
+/// Which road edge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RoadEdge {
+    /// The straight upper (left) edge, Y = Y_u.
+    Upper,
+    /// The piecewise lower (right) edge of Eq. 3, including the merge taper.
+    Lower,
+}
+
+/// Start of a collision episode between two vehicles.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CollisionEvent {
+    /// The checked instant at which the boxes were first found intersecting (s).
+    pub t_s: f64,
+    /// Smaller id of the pair.
+    pub id_a: VehicleId,
+    /// Larger id of the pair.
+    pub id_b: VehicleId,
+    /// Time of first contact between the previous checked instant and `t_s`, from the TTC at
+    /// the previous instant (exact for constant velocities); `None` if the pair was already
+    /// intersecting or not closing then.
+    pub t_contact_estimate_s: Option<f64>,
+    /// Relative speed |v_b − v_a| at `t_s` (m/s).
+    pub relative_speed_mps: f64,
+}
+
+impl CollisionEvent {
+    /// Whether vehicle `id` is one of the two.
+    pub fn involves(&self, id: VehicleId) -> bool {
+        self.id_a == id || self.id_b == id
+    }
+
+    /// One line for logs; `names[id]` names vehicle `id` (falls back to the id).
+    pub fn describe(&self, names: &[String]) -> String {
+        let name = |id: VehicleId| {
+            names
+                .get(id as usize)
+                .cloned()
+                .unwrap_or_else(|| format!("vehicle {id}"))
+        };
+        let contact = self
+            .t_contact_estimate_s
+            .map(|t| format!(", first contact at {t:.3} s"))
+            .unwrap_or_default();
+        format!(
+            "collision {} / {} at t = {:.3} s{contact}, relative speed {:.2} m/s",
+            name(self.id_a),
+            name(self.id_b),
+            self.t_s,
+            self.relative_speed_mps
+        )
+    }
+}
+
+/// Start of an episode of a vehicle touching or crossing a road edge.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EdgeContactEvent {
+    /// The checked instant (s).
+    pub t_s: f64,
+    /// The vehicle.
+    pub id: VehicleId,
+    /// Which edge.
+    pub edge: RoadEdge,
+}
+
+/// Safety figures of one pair of vehicles over the run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PairSafety {
+    /// Smaller id.
+    pub id_a: VehicleId,
+    /// Larger id.
+    pub id_b: VehicleId,
+    /// Minimum exact gap between the boxes (m); 0 when they touched.
+    pub min_gap_m: f64,
+    /// When the minimum gap was first reached (s).
+    pub t_min_gap_s: f64,
+    /// Minimum TTC (s); `None` if never closing within the horizon.
+    pub min_ttc_s: Option<f64>,
+    /// When the minimum TTC was first reached (s).
+    pub t_min_ttc_s: Option<f64>,
+    /// Time with TTC below the threshold (s).
+    pub tet_s: f64,
+    /// Number of collision episodes.
+    pub collisions: u32,
+    /// Near miss: min TTC or min gap below its threshold, without a collision.
+    pub near_miss: bool,
+}
+
+/// The safety outcome of a run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SafetySummary {
+    /// Every collision episode, in time order (pairs in id order within an instant).
+    pub collisions: Vec<CollisionEvent>,
+    /// Minimum exact gap between any two boxes (m); `None` with fewer than two vehicles.
+    pub min_gap_m: Option<f64>,
+    /// When `min_gap_m` was first reached (s).
+    pub t_min_gap_s: Option<f64>,
+    /// Minimum TTC over all pairs and instants (s).
+    pub min_ttc_s: Option<f64>,
+    /// When `min_ttc_s` was first reached (s).
+    pub t_min_ttc_s: Option<f64>,
+    /// Near miss: (min TTC < threshold or min gap < gap threshold) and no collision.
+    pub near_miss: bool,
+    /// Time during which at least one pair had TTC below the threshold (s).
+    pub tet_s: f64,
+    /// Every road-edge contact episode, in time order.
+    pub edge_contacts: Vec<EdgeContactEvent>,
+    /// Per pair, in id order.
+    pub pairs: Vec<PairSafety>,
+    /// Number of checked instants.
+    pub checked_instants: u64,
+    /// Sum of the `dt_s` of the checked instants (s).
+    pub checked_duration_s: f64,
+    /// Shape casts that stopped without converging (their TTC is parry's conservative value).
+    pub ttc_not_converged: u64,
+}
+
+/// What one pair looked like at the last checked instant.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PairInstant {
+    /// Smaller id.
+    pub id_a: VehicleId,
+    /// Larger id.
+    pub id_b: VehicleId,
+    /// Whether the boxes intersect.
+    pub intersecting: bool,
+    /// Gap between the boxes (m): exact, or a lower bound when `gap_is_lower_bound`.
+    pub gap_m: f64,
+    /// True when the pair was far enough apart that only the bounding-circle bound was computed.
+    pub gap_is_lower_bound: bool,
+    /// TTC (s), `None` if not touching within the horizon at constant velocity.
+    pub ttc_s: Option<f64>,
+}
+
+/// The result of one [`SafetyMonitor::check`].
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SafetyStepReport {
+    /// The instant (s).
+    pub t_s: f64,
+    /// Every pair, in id order.
+    pub pairs: Vec<PairInstant>,
+    /// Collision episodes that started at this instant.
+    pub new_collisions: Vec<CollisionEvent>,
+    /// Edge contact episodes that started at this instant.
+    pub new_edge_contacts: Vec<EdgeContactEvent>,
+    /// Smallest TTC at this instant.
+    pub min_ttc_s: Option<f64>,
+}

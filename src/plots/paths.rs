@@ -1,0 +1,104 @@
+//! The paper's Fig. 3: the road and each vehicle's path, one panel per planner.
+
+use planner::MergeRoad;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::motion_states::draw_legend;
+use super::{DrawResult, PlannerSeries, font, padded_range};
+
+/// Fig. 3: the road (edges, divider, merge section shaded) and each vehicle's path, one panel
+/// per planner; the first vehicle solid, the others dashed.
+pub(super) fn draw_paths(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    road: &MergeRoad,
+    series: &[PlannerSeries<'_>],
+    vehicles: &[String],
+) -> DrawResult {
+    let x_range = padded_range(
+        series.iter().flat_map(|s| s.rows.iter().map(|r| r.x_m)),
+        0.01,
+        10.0,
+    );
+    let y_range = (road.y_bottom_m - 0.5)..(road.y_upper_m() + 0.5);
+    let panels = area.split_evenly((series.len(), 1));
+    for (panel, s) in panels.iter().zip(series) {
+        let mut chart = ChartBuilder::on(panel)
+            .caption(format!("{}: paths", s.planner), font(20))
+            .margin(8)
+            .x_label_area_size(34)
+            .y_label_area_size(56)
+            .build_cartesian_2d(x_range.clone(), y_range.clone())
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("x (m)")
+            .y_desc("y (m)")
+            .label_style(font(14))
+            .axis_desc_style(font(14))
+            .light_line_style(WHITE)
+            .draw()
+            .map_err(|e| e.to_string())?;
+        // Merge section, shaded as in the paper.
+        let merge = RGBColor(255, 200, 120).mix(0.35);
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [
+                    (road.merge_start_x_m, road.y_bottom_m),
+                    (road.merge_end_x_m, road.y_upper_m()),
+                ],
+                merge.filled(),
+            )))
+            .map_err(|e| e.to_string())?;
+        let edge = BLACK.stroke_width(2);
+        for line in [road.lower_edge_polyline(), road.upper_edge_polyline()] {
+            chart
+                .draw_series(LineSeries::new(
+                    line.into_iter().map(|p| (p[0], p[1])),
+                    edge,
+                ))
+                .map_err(|e| e.to_string())?;
+        }
+        let divider_end = road.merge_end_x_m.min(road.end_x_m);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [
+                    (road.start_x_m, road.y_lane_m()),
+                    (divider_end, road.y_lane_m()),
+                ],
+                8,
+                6,
+                RGBColor(120, 120, 120).stroke_width(1),
+            ))
+            .map_err(|e| e.to_string())?;
+        for (k, vehicle) in vehicles.iter().enumerate() {
+            let color = if k == 0 {
+                RGBColor(120, 60, 160)
+            } else {
+                let c = Palette99::pick(k + 2).to_rgba();
+                RGBColor(c.0, c.1, c.2)
+            };
+            let points: Vec<(f64, f64)> = s
+                .rows
+                .iter()
+                .filter(|r| r.vehicle == *vehicle)
+                .map(|r| (r.x_m, r.y_m))
+                .collect();
+            let style = color.stroke_width(2);
+            let anchor = if k == 0 {
+                chart
+                    .draw_series(LineSeries::new(points, style))
+                    .map_err(|e| e.to_string())?
+            } else {
+                chart
+                    .draw_series(DashedLineSeries::new(points, 10, 5, style))
+                    .map_err(|e| e.to_string())?
+            };
+            anchor
+                .label(vehicle.clone())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,110 @@
+//! Merging the shards of one sweep into the aggregate of the whole (`merge_sim merge-results`).
+
+use super::{Shard, SweepError, SweepSummary, instance_seed};
+
+/// Combines the summaries of shards (`(origin, summary)`, origin naming the file in errors) into
+/// the summary of the whole sweep: same identity, every shard `i/n` present exactly once.
+pub fn merge_shards(parts: Vec<(String, SweepSummary)>) -> Result<SweepSummary, SweepError> {
+    let Some((first_origin, first)) = parts.first() else {
+        return Err(SweepError::Invalid("no shard files given".into()));
+    };
+    let identity = first.identity();
+    let count = first.shard.count;
+    let mut seen: Vec<Option<&str>> =
+        vec![None; usize::try_from(count).unwrap_or(usize::MAX).min(1 << 20)];
+    if seen.len() as u64 != count {
+        return Err(SweepError::Invalid(format!(
+            "{first_origin}: shard count {count} is too large"
+        )));
+    }
+    for (origin, part) in &parts {
+        let other = part.identity();
+        let fields = [
+            (
+                "scenario",
+                identity.scenario.clone(),
+                other.scenario.clone(),
+            ),
+            (
+                "scenario_fingerprint",
+                identity.scenario_fingerprint.clone(),
+                other.scenario_fingerprint.clone(),
+            ),
+            ("planner", identity.planner.clone(), other.planner.clone()),
+            ("params", identity.params.clone(), other.params.clone()),
+            ("seed", identity.seed.to_string(), other.seed.to_string()),
+            (
+                "total_runs",
+                identity.total_runs.to_string(),
+                other.total_runs.to_string(),
+            ),
+            (
+                "shard count",
+                count.to_string(),
+                part.shard.count.to_string(),
+            ),
+        ];
+        for (name, expected, found) in fields {
+            if expected != found {
+                return Err(SweepError::Invalid(format!(
+                    "{origin}: {name} = {found} differs from {first_origin} ({expected}): not a shard of the same sweep"
+                )));
+            }
+        }
+        let slot = &mut seen[part.shard.index as usize];
+        if let Some(previous) = slot {
+            return Err(SweepError::Invalid(format!(
+                "{origin}: shard {} given twice (also {previous})",
+                part.shard
+            )));
+        }
+        *slot = Some(origin.as_str());
+        let range = part.shard.instances(part.total_runs);
+        let instances: Vec<u64> = part.samples.iter().map(|r| r.instance).collect();
+        if instances != range.clone().collect::<Vec<_>>()
+            || part.instances != [range.start, range.end]
+        {
+            return Err(SweepError::Invalid(format!(
+                "{origin}: shard {} must hold instances {}..{} in order",
+                part.shard, range.start, range.end
+            )));
+        }
+        if let Some(bad) = part
+            .samples
+            .iter()
+            .find(|r| r.seed != instance_seed(part.seed, r.instance))
+        {
+            return Err(SweepError::Invalid(format!(
+                "{origin}: instance {} has seed {}, not the derived {}",
+                bad.instance,
+                bad.seed,
+                instance_seed(part.seed, bad.instance)
+            )));
+        }
+    }
+    let missing: Vec<String> = seen
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.is_none())
+        .map(|(i, _)| format!("{i}/{count}"))
+        .collect();
+    if !missing.is_empty() {
+        return Err(SweepError::Invalid(format!(
+            "missing shards: {}",
+            missing.join(", ")
+        )));
+    }
+    let mut ordered: Vec<&SweepSummary> = parts.iter().map(|(_, p)| p).collect();
+    ordered.sort_by_key(|p| p.shard.index);
+    let wall_time_s = ordered.iter().map(|p| p.wall_time_s).sum();
+    let rows = ordered
+        .into_iter()
+        .flat_map(|p| p.samples.iter().cloned())
+        .collect();
+    Ok(SweepSummary::from_rows(
+        &identity,
+        Shard::WHOLE,
+        rows,
+        wall_time_s,
+    ))
+}

@@ -1,0 +1,246 @@
+//! The aggregate of a sweep (or of one shard): counts, rates with Wilson intervals, nearest-rank
+//! percentiles, means, and the rows it was made from; its identity, table and JSONL.
+
+use scenarios::randomisation::fnv1a64;
+use serde::{Deserialize, Serialize};
+
+use super::rows::JsonlLine;
+use super::statistics::{Z_95, mean, nearest_rank_percentile, wilson_interval};
+use super::{RunMetrics, RunRow, RunStatus, Shard, SweepPlan, planner_label};
+
+/// The aggregate of a sweep or of one shard (the `--json` file). The per-run `samples` are
+/// kept so that shards can be merged into exactly the unsharded aggregate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepSummary {
+    /// Scenario name.
+    pub scenario: String,
+    /// FNV-1a 64 of the nominal scenario's canonical TOML (hex): shards of different scenario
+    /// files that share a name are not merged.
+    pub scenario_fingerprint: String,
+    /// Planner name (`pf-iso`, ..., or `mixed`).
+    pub planner: String,
+    /// Planner parameter set (`paper` or `mergesim`).
+    pub params: String,
+    /// Sweep seed K.
+    pub seed: u64,
+    /// Instances in the whole sweep.
+    pub total_runs: u64,
+    /// Which part of the sweep this is (`0/1`: all of it).
+    pub shard: Shard,
+    /// The instances of this part, `[start, end)`.
+    pub instances: [u64; 2],
+    /// Runs in this part.
+    pub runs: u64,
+    /// Runs that simulated to the end.
+    pub completed: u64,
+    /// Runs whose World returned an error or that panicked.
+    pub diverged: u64,
+    /// Of the diverged runs, those that panicked.
+    pub panicked: u64,
+    /// Completed runs with at least one collision.
+    pub collisions: u64,
+    /// `collisions / completed`.
+    pub collision_rate: Option<f64>,
+    /// 95 % Wilson score interval of the collision rate.
+    pub collision_rate_ci95: Option<[f64; 2]>,
+    /// Completed runs with a near miss (and no collision).
+    pub near_misses: u64,
+    /// `near_misses / completed`.
+    pub near_miss_rate: Option<f64>,
+    /// 95 % Wilson score interval of the near-miss rate.
+    pub near_miss_rate_ci95: Option<[f64; 2]>,
+    /// 5th percentile (nearest rank) of the runs' minimum TTC (s); a run without a closing pair
+    /// counts as +∞, and `null` means the percentile itself is +∞ (or no completed run).
+    pub min_ttc_s_p5: Option<f64>,
+    /// 5th percentile (nearest rank) of the runs' minimum gap (m).
+    pub min_gap_m_p5: Option<f64>,
+    /// Mean over completed runs of the largest |yaw rate| of any vehicle (rad/s).
+    pub mean_peak_yaw_rate_radps: Option<f64>,
+    /// Mean over completed runs of the largest |sideslip| of any vehicle (rad).
+    pub mean_peak_sideslip_rad: Option<f64>,
+    /// Mean over completed runs of the largest |yaw| of any vehicle (rad).
+    pub mean_peak_yaw_rad: Option<f64>,
+    /// Mean over completed runs of the lowest speed of any vehicle (m/s).
+    pub mean_min_speed_mps: Option<f64>,
+    /// Planner fallback cycles, summed over the completed runs.
+    pub fallbacks: u64,
+    /// Completed runs with at least one fallback.
+    pub runs_with_fallbacks: u64,
+    /// Wall-clock time (s): of the sweep, or the sum over merged shards. Not reproducible.
+    pub wall_time_s: f64,
+    /// The runs, in instance order.
+    pub samples: Vec<RunRow>,
+}
+
+/// What identifies a sweep (shared by its shards).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepIdentity {
+    /// Scenario name.
+    pub scenario: String,
+    /// See [`SweepSummary::scenario_fingerprint`].
+    pub scenario_fingerprint: String,
+    /// Planner parameter set.
+    pub params: String,
+    /// Planner name.
+    pub planner: String,
+    /// Sweep seed.
+    pub seed: u64,
+    /// Instances in the whole sweep.
+    pub total_runs: u64,
+}
+
+impl SweepIdentity {
+    /// The identity of a plan.
+    pub fn of(plan: &SweepPlan) -> Self {
+        let canonical = plan.scenario.to_toml().unwrap_or_default();
+        SweepIdentity {
+            scenario: plan.scenario.name.clone(),
+            scenario_fingerprint: format!("{:016x}", fnv1a64(&canonical)),
+            params: plan.scenario.params.name().to_string(),
+            planner: planner_label(&plan.scenario, plan.planner),
+            seed: plan.seed,
+            total_runs: plan.runs,
+        }
+    }
+}
+
+impl SweepSummary {
+    /// The aggregate of `rows` (the instances `shard.instances(total_runs)`, in instance order).
+    pub fn from_rows(
+        identity: &SweepIdentity,
+        shard: Shard,
+        rows: Vec<RunRow>,
+        wall_time_s: f64,
+    ) -> Self {
+        let range = shard.instances(identity.total_runs);
+        let done: Vec<&RunMetrics> = rows.iter().filter_map(|r| r.metrics.as_ref()).collect();
+        let completed = done.len() as u64;
+        let count = |f: &dyn Fn(&RunMetrics) -> bool| done.iter().filter(|m| f(m)).count() as u64;
+        let collisions = count(&|m| m.collisions > 0);
+        let near_misses = count(&|m| m.near_miss);
+        let rate = |k: u64| (completed > 0).then(|| k as f64 / completed as f64);
+        let p5 = |f: &dyn Fn(&RunMetrics) -> Option<f64>| {
+            let mut values: Vec<f64> = done.iter().map(|m| f(m).unwrap_or(f64::INFINITY)).collect();
+            values.sort_by(f64::total_cmp);
+            nearest_rank_percentile(&values, 5.0).filter(|v| v.is_finite())
+        };
+        let mean_of =
+            |f: &dyn Fn(&RunMetrics) -> f64| mean(&done.iter().map(|m| f(m)).collect::<Vec<_>>());
+        let panicked = rows
+            .iter()
+            .filter(|r| r.status == RunStatus::Panicked)
+            .count() as u64;
+        SweepSummary {
+            scenario: identity.scenario.clone(),
+            scenario_fingerprint: identity.scenario_fingerprint.clone(),
+            params: identity.params.clone(),
+            planner: identity.planner.clone(),
+            seed: identity.seed,
+            total_runs: identity.total_runs,
+            shard,
+            instances: [range.start, range.end],
+            runs: rows.len() as u64,
+            completed,
+            diverged: rows.len() as u64 - completed,
+            panicked,
+            collisions,
+            collision_rate: rate(collisions),
+            collision_rate_ci95: wilson_interval(collisions, completed, Z_95),
+            near_misses,
+            near_miss_rate: rate(near_misses),
+            near_miss_rate_ci95: wilson_interval(near_misses, completed, Z_95),
+            min_ttc_s_p5: p5(&|m| m.min_ttc_s),
+            min_gap_m_p5: p5(&|m| m.min_gap_m),
+            mean_peak_yaw_rate_radps: mean_of(&|m| m.peak_yaw_rate_radps),
+            mean_peak_sideslip_rad: mean_of(&|m| m.peak_sideslip_rad),
+            mean_peak_yaw_rad: mean_of(&|m| m.peak_yaw_rad),
+            mean_min_speed_mps: mean_of(&|m| m.min_speed_mps),
+            fallbacks: done.iter().map(|m| m.fallbacks).sum(),
+            runs_with_fallbacks: count(&|m| m.fallbacks > 0),
+            wall_time_s,
+            samples: rows,
+        }
+    }
+
+    /// The identity of the sweep this summary belongs to.
+    pub fn identity(&self) -> SweepIdentity {
+        SweepIdentity {
+            scenario: self.scenario.clone(),
+            scenario_fingerprint: self.scenario_fingerprint.clone(),
+            params: self.params.clone(),
+            planner: self.planner.clone(),
+            seed: self.seed,
+            total_runs: self.total_runs,
+        }
+    }
+
+    /// A few lines for the terminal.
+    pub fn table(&self) -> String {
+        let opt = |v: Option<f64>, digits: usize| {
+            v.map(|x| format!("{x:.digits$}"))
+                .unwrap_or_else(|| "-".into())
+        };
+        let ci = |v: Option<[f64; 2]>| {
+            v.map(|[l, h]| format!("[{l:.4}, {h:.4}]"))
+                .unwrap_or_else(|| "-".into())
+        };
+        let per_s = if self.wall_time_s > 0.0 {
+            self.runs as f64 / self.wall_time_s
+        } else {
+            0.0
+        };
+        format!(
+            "sweep {} {}: seed {}, shard {} (instances {}..{} of {}), {} runs in {:.1} s wall ({:.2} runs/s)\n\
+             completed {}  diverged {} (panicked {})\n\
+             collisions {}  rate {}  95% CI {}\n\
+             near misses {}  rate {}  95% CI {}\n\
+             p5 min TTC {} s  p5 min gap {} m\n\
+             mean peak |r| {} rad/s  mean peak |β| {} rad  mean peak |ψ| {} rad  mean min v {} m/s\n\
+             fallback cycles {} (in {} runs)\n",
+            self.scenario,
+            self.planner,
+            self.seed,
+            self.shard,
+            self.instances[0],
+            self.instances[1],
+            self.total_runs,
+            self.runs,
+            self.wall_time_s,
+            per_s,
+            self.completed,
+            self.diverged,
+            self.panicked,
+            self.collisions,
+            opt(self.collision_rate, 4),
+            ci(self.collision_rate_ci95),
+            self.near_misses,
+            opt(self.near_miss_rate, 4),
+            ci(self.near_miss_rate_ci95),
+            opt(self.min_ttc_s_p5, 3),
+            opt(self.min_gap_m_p5, 3),
+            opt(self.mean_peak_yaw_rate_radps, 4),
+            opt(self.mean_peak_sideslip_rad, 4),
+            opt(self.mean_peak_yaw_rad, 4),
+            opt(self.mean_min_speed_mps, 2),
+            self.fallbacks,
+            self.runs_with_fallbacks,
+        )
+    }
+
+    /// The JSONL text of the runs (one line each, with scenario, planner and wall time).
+    pub fn jsonl(&self, wall_times_s: &[f64]) -> Result<String, serde_json::Error> {
+        let mut text = String::new();
+        for (i, row) in self.samples.iter().enumerate() {
+            let line = JsonlLine {
+                scenario: &self.scenario,
+                planner: &self.planner,
+                row,
+                wall_time_s: wall_times_s.get(i).copied().unwrap_or(0.0),
+            };
+            text.push_str(&serde_json::to_string(&line)?);
+            text.push('\n');
+        }
+        Ok(text)
+    }
+}
