@@ -4,6 +4,7 @@
 //! the benchmarks: [`planner`] (pure potential-field planning with interactive speed
 //! optimisation), [`vehicles`] (Rapier vehicles and tracker), [`sim`] (the closed loop) and
 //! [`scenarios`] (scenario files).
+#![warn(missing_docs)]
 
 pub mod experiment;
 pub mod grid;

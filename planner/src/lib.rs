@@ -4,6 +4,7 @@
 //! No physics engine, no logging backend: plain state in, plan out, so it can run on a car.
 //! `planner/README.md` maps each equation of the paper to the function implementing it and
 //! lists every reading of a typo or unit problem.
+#![warn(missing_docs)]
 
 pub mod attractive_field;
 pub mod behaviour;
@@ -36,3 +37,8 @@ pub use potential_field::{GridSpec, PotentialField};
 pub use road::{Lane, MergeRoad};
 pub use speed_profile::SpeedProfile;
 pub use types::*;
+
+/// The README's examples, compiled and run as doc tests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -5,6 +5,7 @@
 //! a Monte-Carlo sweep draws instances from. Unknown keys are rejected; every number is
 //! range-checked, for the nominal values and for every instance the ranges allow; errors name
 //! the file, the line and the field.
+#![warn(missing_docs)]
 
 pub mod builtin;
 pub mod distribution;

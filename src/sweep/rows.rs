@@ -82,7 +82,7 @@ impl RunMetrics {
 pub struct RunRow {
     /// Instance index i in `0..runs`.
     pub instance: u64,
-    /// The run's seed, [`instance_seed`]`(K, i)`: `merge_sim run --seed <seed>` replays it.
+    /// The run's seed, [`instance_seed`](super::instance_seed)`(K, i)`: `merge_sim run --seed <seed>` replays it.
     pub seed: u64,
     /// How it ended.
     pub status: RunStatus,

@@ -12,6 +12,7 @@
 //! vehicle.apply_forces(&mut world, mu);   // every vehicle, in id order
 //! world.step();
 //! ```
+#![warn(missing_docs)]
 
 pub mod collision_groups;
 pub mod controls;

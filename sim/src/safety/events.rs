@@ -139,7 +139,7 @@ pub struct PairInstant {
     pub ttc_s: Option<f64>,
 }
 
-/// The result of one [`SafetyMonitor::check`].
+/// The result of one [`SafetyMonitor::check`](super::SafetyMonitor::check).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SafetyStepReport {
     /// The instant (s).
