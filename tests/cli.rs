@@ -120,7 +120,10 @@ fn recording_is_written_and_decodes_with_rerun_s_own_decoder() {
     }
     assert!(messages > 10, "{messages} messages");
     for entity in ["/world/vehicles", "/world/paths/ego/planned", "/events"] {
-        assert!(entities.contains(entity), "{entity} missing from {entities:?}");
+        assert!(
+            entities.contains(entity),
+            "{entity} missing from {entities:?}"
+        );
     }
     // With a Rerun CLI of the same version (`.ci/run` installs it and sets this), let it
     // verify the file too.

@@ -33,8 +33,8 @@ use crate::speed_optimisation::{
     Aggregate, SpeedOptimiser, SpeedProblem, SpeedTerm, friction_speed_limits,
 };
 use crate::types::{
-    FallbackReason, Neighbour, PathPoint, Plan, SharedLocalPath, TimedWaypoint, VehicleId,
-    VehicleShape, VehicleState,
+    FallbackReason, Neighbour, PathPoint, Plan, SharedLocalPath, VehicleId, VehicleShape,
+    VehicleState,
 };
 
 /// Which planner a vehicle runs.
@@ -544,20 +544,13 @@ impl PfPlanner {
         }) {
             return Err(fail(non_finite("planned path"), Some(waypoints)));
         }
-        let shared = SharedLocalPath {
-            vehicle_id: req.ego_id,
-            stamp_s: req.time_s,
-            shape: req.ego_shape,
-            speed_mps: req.ego.speed_mps,
-            waypoints: path
-                .iter()
-                .map(|p| TimedWaypoint {
-                    t_s: p.t_s,
-                    x_m: p.x_m,
-                    y_m: p.y_m,
-                })
-                .collect(),
-        };
+        let shared = SharedLocalPath::from_path(
+            req.ego_id,
+            req.time_s,
+            req.ego_shape,
+            req.ego.speed_mps,
+            &path,
+        );
         Ok(Plan {
             waypoints,
             path,

@@ -6,7 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::PlannerError;
-use crate::types::{PathPoint, Plan, TimedWaypoint};
+use crate::types::{PathPoint, Plan, SharedLocalPath};
 
 /// Slowest speed a profile may prescribe (m/s): the speed optimiser's own v_min, so every
 /// segment has a finite travel time.
@@ -105,15 +105,14 @@ impl Plan {
     pub fn with_speed_profile(&self, profile: &SpeedProfile) -> Plan {
         let mut plan = self.clone();
         retime_path(&mut plan.path, profile);
-        plan.shared.waypoints = plan
-            .path
-            .iter()
-            .map(|p| TimedWaypoint {
-                t_s: p.t_s,
-                x_m: p.x_m,
-                y_m: p.y_m,
-            })
-            .collect();
+        let shared = &plan.shared;
+        plan.shared = SharedLocalPath::from_path(
+            shared.vehicle_id,
+            shared.stamp_s,
+            shared.shape,
+            shared.speed_mps,
+            &plan.path,
+        );
         plan
     }
 }

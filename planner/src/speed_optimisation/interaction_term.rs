@@ -174,20 +174,7 @@ mod tests {
             fields,
         );
         let v: Vec<f64> = (0..n).map(|i| 14.0 + 0.1 * i as f64).collect();
-        let (_, g) = term.value_and_gradient(&v);
-        let h = 1e-6;
-        for j in 0..n {
-            let mut up = v.clone();
-            up[j] += h;
-            let mut down = v.clone();
-            down[j] -= h;
-            let fd = (term.value(&up) - term.value(&down)) / (2.0 * h);
-            assert!(
-                (g[j] - fd).abs() < 1e-6 * (1.0 + fd.abs()),
-                "j = {j}: {} vs {fd}",
-                g[j]
-            );
-        }
+        let g = super::super::assert_gradient_matches_central_differences(&term, &v);
         assert!(
             g.iter().any(|gi| gi.abs() > 1e-3),
             "the term must act: {g:?}"

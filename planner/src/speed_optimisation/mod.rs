@@ -140,3 +140,27 @@ fn smooth_gradient(params: &PlannerParams, problem: &SpeedProblem<'_>, i: usize,
     -params.travel_time_weight * problem.segment_lengths_m[i] / (v * v)
         + params.speed_deviation_weight * (v - problem.target_speed_mps)
 }
+
+/// Asserts that `term`'s gradient at `speeds_mps` matches central differences (relative 1e-6)
+/// and returns it.
+#[cfg(test)]
+pub(crate) fn assert_gradient_matches_central_differences(
+    term: &dyn SpeedTerm,
+    speeds_mps: &[f64],
+) -> Vec<f64> {
+    let (_, g) = term.value_and_gradient(speeds_mps);
+    let h = 1e-6;
+    for j in 0..speeds_mps.len() {
+        let mut up = speeds_mps.to_vec();
+        up[j] += h;
+        let mut down = speeds_mps.to_vec();
+        down[j] -= h;
+        let fd = (term.value(&up) - term.value(&down)) / (2.0 * h);
+        assert!(
+            (g[j] - fd).abs() < 1e-6 * (1.0 + fd.abs()),
+            "j = {j}: {} vs {fd}",
+            g[j]
+        );
+    }
+    g
+}

@@ -42,19 +42,26 @@ pub(crate) enum Command {
     Grid(GridArgs),
 }
 
+/// Which scenario, with which planner parameter set.
 #[derive(Args, Debug, Clone)]
-pub(crate) struct RunArgs {
+pub(crate) struct ScenarioArgs {
     /// Built-in scenario name or path to a scenario TOML file.
     #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
     pub(crate) scenario: String,
-    /// Planner of every planner-driven vehicle (overrides the scenario's choice).
-    #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
-    pub(crate) planner: Option<PlannerKind>,
     /// Planner parameter set: `paper` (the paper's literal reading) or `mergesim` (our
     /// improvements) [default: the scenario's `params`, else mergesim]. The scenario's
     /// [sim.planner] values apply on top of it.
     #[arg(long, value_name = "SET", value_parser = parse_params)]
     pub(crate) params: Option<ParameterSet>,
+}
+
+#[derive(Args, Debug, Clone)]
+pub(crate) struct RunArgs {
+    #[command(flatten)]
+    pub(crate) source: ScenarioArgs,
+    /// Planner of every planner-driven vehicle (overrides the scenario's choice).
+    #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
+    pub(crate) planner: Option<PlannerKind>,
     /// Run the scenario instance drawn with seed N from its [randomise] ranges (N also seeds
     /// the V2V drops); a sweep's per-run rows give each run's seed. Without it the nominal
     /// scenario runs.
@@ -82,18 +89,12 @@ pub(crate) struct RunArgs {
 
 #[derive(Args, Debug)]
 pub(crate) struct CompareArgs {
-    /// Built-in scenario name or path to a scenario TOML file.
-    #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
-    pub(crate) scenario: String,
+    #[command(flatten)]
+    pub(crate) source: ScenarioArgs,
     /// Planners to compare, comma-separated.
     #[arg(long, value_delimiter = ',', value_parser = parse_planner,
           default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
     pub(crate) planners: Vec<PlannerKind>,
-    /// Planner parameter set: `paper` (the paper's literal reading) or `mergesim` (our
-    /// improvements) [default: the scenario's `params`, else mergesim]. The scenario's
-    /// [sim.planner] values apply on top of it.
-    #[arg(long, value_name = "SET", value_parser = parse_params)]
-    pub(crate) params: Option<ParameterSet>,
 
     /// Compare on the scenario instance drawn with seed N (as `run --seed N`); without it the
     /// nominal scenario.
@@ -164,17 +165,11 @@ pub(crate) fn parse_params(text: &str) -> Result<ParameterSet, String> {
 
 #[derive(Args, Debug)]
 pub(crate) struct SweepArgs {
-    /// Built-in scenario name or path to a scenario TOML file.
-    #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
-    pub(crate) scenario: String,
+    #[command(flatten)]
+    pub(crate) source: ScenarioArgs,
     /// Planner of every planner-driven vehicle (overrides the scenario's choice).
     #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
     pub(crate) planner: Option<PlannerKind>,
-    /// Planner parameter set: `paper` (the paper's literal reading) or `mergesim` (our
-    /// improvements) [default: the scenario's `params`, else mergesim]. The scenario's
-    /// [sim.planner] values apply on top of it.
-    #[arg(long, value_name = "SET", value_parser = parse_params)]
-    pub(crate) params: Option<ParameterSet>,
     /// Number of randomised instances in the whole sweep (at least 1).
     #[arg(long, value_name = "N", value_parser = parse_runs)]
     pub(crate) runs: u64,
@@ -216,12 +211,8 @@ pub(crate) struct MergeResultsArgs {
 
 #[derive(Args, Debug)]
 pub(crate) struct GridArgs {
-    /// Built-in scenario name or path to a scenario TOML file.
-    #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
-    pub(crate) scenario: String,
-    /// Base parameter set of every cell (the four grid parameters are set on top of it).
-    #[arg(long, value_name = "SET", value_parser = parse_params)]
-    pub(crate) params: Option<ParameterSet>,
+    #[command(flatten)]
+    pub(crate) source: ScenarioArgs,
     /// Planners, comma-separated; the first is the reference of the paired differences.
     #[arg(long, value_delimiter = ',', value_parser = parse_planner,
           default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]

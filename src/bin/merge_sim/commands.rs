@@ -18,7 +18,7 @@ use crate::{
 };
 
 pub(crate) fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
-    let scenario = load_scenario(&args.scenario, args.params)?;
+    let scenario = load_scenario(&args.source.scenario, args.source.params)?;
     let label = mergesim::sweep::planner_label(&scenario, args.planner);
     let rrd = if args.no_rrd {
         None
@@ -87,7 +87,7 @@ pub(crate) fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
 }
 
 pub(crate) fn cmd_compare(args: &CompareArgs) -> Result<(), Failure> {
-    let scenario = load_scenario(&args.scenario, args.params)?;
+    let scenario = load_scenario(&args.source.scenario, args.source.params)?;
     if let Some(path) = &args.json {
         check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
     }
@@ -193,7 +193,7 @@ pub(crate) fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
 
 pub(crate) fn cmd_sweep(args: &SweepArgs) -> Result<(), Failure> {
     use mergesim::sweep::{Shard, SweepOptions, SweepPlan, run_sweep};
-    let scenario = load_scenario(&args.scenario, args.params)?;
+    let scenario = load_scenario(&args.source.scenario, args.source.params)?;
     for (path, what) in [
         (args.json.as_deref(), "--json"),
         (args.jsonl.as_deref(), "--jsonl"),
@@ -291,7 +291,7 @@ const MAX_GRID_RUNS: u64 = 10_000;
 
 pub(crate) fn cmd_grid(args: &GridArgs) -> Result<(), Failure> {
     use mergesim::grid::{GridAxes, GridMetric, GridPlan, job_count, run_grid};
-    let scenario = load_scenario(&args.scenario, args.params)?;
+    let scenario = load_scenario(&args.source.scenario, args.source.params)?;
     if !scenario.vehicles.iter().any(|v| v.name == args.vehicle) {
         return Err(input(anyhow!(
             "--vehicle {:?}: no such vehicle in scenario {} (vehicles: {})",
