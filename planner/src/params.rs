@@ -7,6 +7,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use mergesim_types::Bound;
+use mergesim_types::bounds;
+
 use crate::error::PlannerError;
 use crate::obstacle_field::{HeadingForm, MinDistanceLength, ObstacleFieldParams};
 use crate::prediction::PredictionModel;
@@ -306,28 +309,91 @@ fn invalid(name: &str, value: f64, reason: &str) -> PlannerError {
     PlannerError::invalid(format!("planner.{name}"), value, reason)
 }
 
+/// Allowed range of every numeric field (`PlannerParams::validate`, README "Limits"). They keep
+/// each planning cycle's work bounded (at most 200 waypoints, 50 SCP solves of at most 1000
+/// interior-point iterations, a horizon of at most 400 s) and the numbers physical.
+pub const PLANNER_BOUNDS: &[Bound] = &[
+    Bound::above("attractive_gain_per_m2", 0.0, 10.0, "1/m²"),
+    Bound::closed("target_lookahead_m", 1.0, 200.0, "m"),
+    Bound::closed("lane_amplitude", 0.0, 10.0, ""),
+    Bound::closed("lane_sigma_m", 0.1, 5.0, "m"),
+    Bound::closed("edge_gain_m2", 0.0, 10.0, "m²"),
+    Bound::closed("edge_clamp_distance_m", 0.01, 2.0, "m"),
+    Bound::above("obstacle_amplitude", 0.0, 100.0, ""),
+    Bound::open("obstacle_epsilon", 0.0, 1.0, ""),
+    Bound::closed("obstacle_lateral_safety_m", 0.5, 20.0, "m"),
+    Bound::open("obstacle_fraction_at_min_distance", 0.0, 1.0, ""),
+    Bound::closed("obstacle_time_gap_s", 0.0, 10.0, "s"),
+    Bound::closed("ego_mass_factor", 0.1, 10.0, ""),
+    Bound::closed("other_mass_factor", 0.1, 10.0, ""),
+    Bound::closed(
+        "waypoint_count",
+        MIN_WAYPOINTS as f64,
+        MAX_WAYPOINTS as f64,
+        "",
+    ),
+    Bound::closed("step_time_s", 0.01, 2.0, "s"),
+    Bound::closed("min_step_m", 0.01, 20.0, "m"),
+    Bound::closed("max_substep_m", 0.01, 1000.0, "m"),
+    Bound::closed("substep_max_turn_rad", 0.0, std::f64::consts::PI, "rad"),
+    Bound::closed("cubic_origin_weight", 0.0, 1e6, ""),
+    Bound::above("cubic_max_offset_m", 0.0, 10.0, "m"),
+    Bound::open(
+        "cubic_max_heading_rad",
+        0.0,
+        std::f64::consts::FRAC_PI_2,
+        "rad",
+    ),
+    Bound::above("cubic_max_curvature_per_m", 0.0, 1.0, "1/m"),
+    Bound::above("cubic_max_curvature_rate_per_m2", 0.0, 1.0, "1/m²"),
+    Bound::above("speed_limit_mps", 0.0, 100.0, "m/s"),
+    Bound::closed("min_speed_mps", 0.01, 10.0, "m/s"),
+    Bound::closed("travel_time_weight", 0.0, 1e4, "1/s"),
+    Bound::above("speed_deviation_weight", 0.0, 1e4, "s²/m²"),
+    Bound::closed("interaction_weight", 0.0, 1e4, ""),
+    Bound::above("interaction_floor", 0.0, 10.0, ""),
+    Bound::closed("interaction_time_gap_s", 0.0, 10.0, "s"),
+    Bound::open("interaction_epsilon", 0.0, 1.0, ""),
+    Bound::closed("interaction_lateral_safety_m", 0.5, 20.0, "m"),
+    Bound::open("interaction_fraction_at_min_distance", 0.0, 1.0, ""),
+    Bound::above("trust_region_mps", 0.0, 50.0, "m/s"),
+    Bound::closed("max_scp_iterations", 1.0, 50.0, ""),
+    Bound::closed("scp_relative_tolerance", 0.0, 1.0, ""),
+    Bound::above("max_accel_mps2", 0.0, 20.0, "m/s²"),
+    Bound::above("max_jerk_mps3", 0.0, 100.0, "m/s³"),
+    Bound::closed("solver_max_iterations", 0.0, 1000.0, ""),
+    Bound::closed("solver_tolerance", 1e-12, 1e-2, ""),
+    Bound::closed("max_shared_path_age_s", 0.0, 60.0, "s"),
+    Bound::closed("risk_weight", 0.0, 1e4, ""),
+    Bound::above("fallback_decel_mps2", 0.0, 20.0, "m/s²"),
+];
+
 impl PlannerParams {
-    /// Checks every field; the error names the first offending field and its value.
-    pub fn validate(&self) -> Result<(), PlannerError> {
-        let positive = [
+    /// The numeric fields with their values, in declaration order (see [`PLANNER_BOUNDS`]).
+    fn bounded_values(&self) -> Vec<(&'static str, f64)> {
+        vec![
             ("attractive_gain_per_m2", self.attractive_gain_per_m2),
             ("target_lookahead_m", self.target_lookahead_m),
+            ("lane_amplitude", self.lane_amplitude),
             ("lane_sigma_m", self.lane_sigma_m),
+            ("edge_gain_m2", self.edge_gain_m2),
             ("edge_clamp_distance_m", self.edge_clamp_distance_m),
             ("obstacle_amplitude", self.obstacle_amplitude),
             ("obstacle_epsilon", self.obstacle_epsilon),
-            ("interaction_floor", self.interaction_floor),
-            ("interaction_epsilon", self.interaction_epsilon),
-            (
-                "interaction_lateral_safety_m",
-                self.interaction_lateral_safety_m,
-            ),
             ("obstacle_lateral_safety_m", self.obstacle_lateral_safety_m),
+            (
+                "obstacle_fraction_at_min_distance",
+                self.obstacle_fraction_at_min_distance,
+            ),
+            ("obstacle_time_gap_s", self.obstacle_time_gap_s),
             ("ego_mass_factor", self.ego_mass_factor),
             ("other_mass_factor", self.other_mass_factor),
+            ("waypoint_count", self.waypoint_count as f64),
             ("step_time_s", self.step_time_s),
             ("min_step_m", self.min_step_m),
             ("max_substep_m", self.max_substep_m),
+            ("substep_max_turn_rad", self.substep_max_turn_rad),
+            ("cubic_origin_weight", self.cubic_origin_weight),
             ("cubic_max_offset_m", self.cubic_max_offset_m),
             ("cubic_max_heading_rad", self.cubic_max_heading_rad),
             ("cubic_max_curvature_per_m", self.cubic_max_curvature_per_m),
@@ -337,90 +403,57 @@ impl PlannerParams {
             ),
             ("speed_limit_mps", self.speed_limit_mps),
             ("min_speed_mps", self.min_speed_mps),
-            ("speed_deviation_weight", self.speed_deviation_weight),
-            ("trust_region_mps", self.trust_region_mps),
-            ("max_accel_mps2", self.max_accel_mps2),
-            ("max_jerk_mps3", self.max_jerk_mps3),
-            ("solver_tolerance", self.solver_tolerance),
-            ("fallback_decel_mps2", self.fallback_decel_mps2),
-        ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(invalid(name, value, "must be finite and > 0"));
-            }
-        }
-        let non_negative = [
-            ("lane_amplitude", self.lane_amplitude),
-            ("edge_gain_m2", self.edge_gain_m2),
-            ("obstacle_time_gap_s", self.obstacle_time_gap_s),
-            ("cubic_origin_weight", self.cubic_origin_weight),
             ("travel_time_weight", self.travel_time_weight),
+            ("speed_deviation_weight", self.speed_deviation_weight),
             ("interaction_weight", self.interaction_weight),
+            ("interaction_floor", self.interaction_floor),
             ("interaction_time_gap_s", self.interaction_time_gap_s),
-            ("risk_weight", self.risk_weight),
-            ("scp_relative_tolerance", self.scp_relative_tolerance),
-            ("max_shared_path_age_s", self.max_shared_path_age_s),
-            ("substep_max_turn_rad", self.substep_max_turn_rad),
-        ];
-        for (name, value) in non_negative {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(invalid(name, value, "must be finite and >= 0"));
-            }
-        }
-        if self.obstacle_epsilon >= self.obstacle_amplitude {
-            return Err(invalid(
-                "obstacle_epsilon",
-                self.obstacle_epsilon,
-                "must be below planner.obstacle_amplitude (σ_y = d/√(−2 ln(ε/A)))",
-            ));
-        }
-        if self.interaction_epsilon >= self.obstacle_amplitude {
-            return Err(invalid(
-                "interaction_epsilon",
-                self.interaction_epsilon,
-                "must be below planner.obstacle_amplitude (σ_y = d/√(−2 ln(ε/A)))",
-            ));
-        }
-        for (name, fraction) in [
+            ("interaction_epsilon", self.interaction_epsilon),
             (
-                "obstacle_fraction_at_min_distance",
-                self.obstacle_fraction_at_min_distance,
+                "interaction_lateral_safety_m",
+                self.interaction_lateral_safety_m,
             ),
             (
                 "interaction_fraction_at_min_distance",
                 self.interaction_fraction_at_min_distance,
             ),
+            ("trust_region_mps", self.trust_region_mps),
+            ("max_scp_iterations", self.max_scp_iterations as f64),
+            ("scp_relative_tolerance", self.scp_relative_tolerance),
+            ("max_accel_mps2", self.max_accel_mps2),
+            ("max_jerk_mps3", self.max_jerk_mps3),
+            (
+                "solver_max_iterations",
+                f64::from(self.solver_max_iterations),
+            ),
+            ("solver_tolerance", self.solver_tolerance),
+            ("max_shared_path_age_s", self.max_shared_path_age_s),
+            ("risk_weight", self.risk_weight),
+            ("fallback_decel_mps2", self.fallback_decel_mps2),
+        ]
+    }
+
+    /// Checks every field against [`PLANNER_BOUNDS`] and the fields against each other; the
+    /// error names the first offending field and its value.
+    pub fn validate(&self) -> Result<(), PlannerError> {
+        bounds::check_all("planner", PLANNER_BOUNDS, &self.bounded_values())?;
+        for (name, epsilon) in [
+            ("obstacle_epsilon", self.obstacle_epsilon),
+            ("interaction_epsilon", self.interaction_epsilon),
         ] {
-            if !(fraction > 0.0 && fraction < 1.0) {
-                return Err(invalid(name, fraction, "must lie in (0, 1)"));
+            if epsilon >= self.obstacle_amplitude {
+                return Err(invalid(
+                    name,
+                    epsilon,
+                    "must be below planner.obstacle_amplitude (σ_y = d/√(−2 ln(ε/A)))",
+                ));
             }
-        }
-        if self.cubic_max_heading_rad >= std::f64::consts::FRAC_PI_2 {
-            return Err(invalid(
-                "cubic_max_heading_rad",
-                self.cubic_max_heading_rad,
-                "must be below π/2",
-            ));
-        }
-        if !(MIN_WAYPOINTS..=MAX_WAYPOINTS).contains(&self.waypoint_count) {
-            return Err(invalid(
-                "waypoint_count",
-                self.waypoint_count as f64,
-                &format!("must lie in [{MIN_WAYPOINTS}, {MAX_WAYPOINTS}] (a cubic needs 4 points)"),
-            ));
         }
         if self.min_speed_mps >= self.speed_limit_mps {
             return Err(invalid(
                 "min_speed_mps",
                 self.min_speed_mps,
                 "must be below planner.speed_limit_mps",
-            ));
-        }
-        if self.max_scp_iterations == 0 {
-            return Err(invalid(
-                "max_scp_iterations",
-                0.0,
-                "must be >= 1 (the first iteration is the convex solve itself)",
             ));
         }
         Ok(())
@@ -479,6 +512,39 @@ impl PlannerParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_numeric_field_has_exactly_one_bound() {
+        let values = PlannerParams::default().bounded_values();
+        assert_eq!(values.len(), PLANNER_BOUNDS.len());
+        for (field, _) in &values {
+            assert_eq!(
+                PLANNER_BOUNDS.iter().filter(|b| b.field == *field).count(),
+                1,
+                "{field}"
+            );
+        }
+    }
+
+    #[test]
+    fn work_and_magnitudes_are_bounded() {
+        for (field, value) in [
+            ("max_scp_iterations", 1000.0),
+            ("step_time_s", 1e300),
+            ("min_step_m", 1e300),
+            ("waypoint_count", 1e6),
+        ] {
+            let mut params = PlannerParams::default();
+            match field {
+                "max_scp_iterations" => params.max_scp_iterations = value as usize,
+                "step_time_s" => params.step_time_s = value,
+                "min_step_m" => params.min_step_m = value,
+                _ => params.waypoint_count = value as usize,
+            }
+            let err = params.validate().unwrap_err().to_string();
+            assert!(err.contains(field), "{err}");
+        }
+    }
 
     #[test]
     fn default_is_valid() {

@@ -286,6 +286,48 @@ impl Scenario {
                     ),
                 });
             }
+            // The body must lie on the road surface at spawn, over the whole randomisation box:
+            // inside [start_x_m, end_x_m] and between the edges (the lower edge at its highest
+            // point under the body, since it rises through the merge section).
+            let lower_edge_m = road.lower_edge_y_m(x[0]).max(road.lower_edge_y_m(x[1]));
+            let off_road = if x[0] < road.start_x_m || x[1] > road.end_x_m {
+                Some(format!(
+                    "its body spans x = [{:.3}, {:.3}] m, beyond the road's [road.start_x_m, \
+                     road.end_x_m] = [{}, {}] m",
+                    x[0], x[1], road.start_x_m, road.end_x_m
+                ))
+            } else if y[0] < lower_edge_m || y[1] > road.y_upper_m() {
+                Some(format!(
+                    "its body spans y = [{:.3}, {:.3}] m, beyond the road's edges [{:.3}, {:.3}] m \
+                     there",
+                    y[0],
+                    y[1],
+                    lower_edge_m,
+                    road.y_upper_m()
+                ))
+            } else {
+                None
+            };
+            if let Some(why) = off_road {
+                let y_entry = self
+                    .randomise
+                    .vehicle_entry_path(&v.name, "y_offset_m")
+                    .or_else(|| self.nominal_path(&format!("vehicles[{}].y_offset_m", v.name)));
+                let lateral = why.starts_with("its body spans y");
+                return Err(ScenarioError::Invalid {
+                    origin: origin.to_string(),
+                    line: at(if lateral { y_entry } else { x_entry() }),
+                    field: Some(format!(
+                        "vehicles[{}].{}",
+                        v.name,
+                        if lateral { "y_offset_m" } else { "x_m" }
+                    )),
+                    message: format!(
+                        "vehicles[{}] must start on the road, including randomisation: {why}",
+                        v.name
+                    ),
+                });
+            }
             for (other, ox, oy) in &hulls {
                 let overlap = |a: [f64; 2], o: &[f64; 2]| a[0] < o[1] && o[0] < a[1];
                 if overlap(x, ox) && overlap(y, oy) {

@@ -4,7 +4,9 @@ use planner::{Lane, MergeRoad, PlannerParams, SpeedProfile};
 use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
 
-use crate::error::{InvalidParameter, SimError};
+use mergesim_types::{Bound, bounds};
+
+use crate::error::SimError;
 use crate::idm::IdmParams;
 use crate::safety::SafetyParams;
 use crate::v2v::V2vParams;
@@ -61,37 +63,59 @@ impl Default for SimConfig {
     }
 }
 
+/// Allowed ranges of the `[sim]` table's own fields (README "Limits"); every period must also
+/// be at least one physics step.
+pub const SIM_BOUNDS: &[Bound] = &[
+    Bound::above("mu", 0.0, 2.0, ""),
+    Bound::closed("dt_s", 1e-4, 0.02, "s"),
+    Bound::above("duration_s", 0.0, 3600.0, "s"),
+    Bound::closed("planner_period_s", 1e-4, 10.0, "s"),
+    Bound::closed("log_period_s", 1e-4, 10.0, "s"),
+    Bound::closed("field_log_period_s", 1e-4, 10.0, "s"),
+    Bound::closed("safety_period_s", 1e-4, 10.0, "s"),
+];
+
+/// Allowed ranges of a vehicle's own fields (`[[vehicles]]`); `x_m` must also lie on the road
+/// and the body must fit on it at spawn (checked by the scenario loader).
+pub const VEHICLE_BOUNDS: &[Bound] = &[
+    Bound::closed("y_offset_m", -1.0, 1.0, "m"),
+    Bound::closed("speed_mps", 0.0, 60.0, "m/s"),
+    Bound::closed("target_speed_mps", 0.5, 60.0, "m/s"),
+];
+
+/// Most vehicles a scenario may hold (every vehicle plans against every other).
+pub const MAX_VEHICLES: usize = 200;
+
 impl SimConfig {
-    /// Checks every field; the error names it and its value.
+    /// Checks every field against its bounds and the periods against the physics step; the
+    /// error names the field and its value.
     pub fn validate(&self) -> Result<(), SimError> {
-        let bad = |name: &str, value: f64, reason: &str| {
-            SimError::InvalidParameter(InvalidParameter::new(name, value, reason))
-        };
         self.road.validate()?;
-        if !(self.mu.is_finite() && self.mu > 0.0 && self.mu <= 2.0) {
-            return Err(bad("mu", self.mu, "must lie in (0, 2]"));
-        }
-        if !(self.dt_s.is_finite() && self.dt_s >= 1e-4 && self.dt_s <= 0.02) {
-            return Err(bad("dt_s", self.dt_s, "must lie in [0.0001, 0.02] s"));
-        }
-        if !(self.duration_s.is_finite() && self.duration_s > 0.0 && self.duration_s <= 3600.0) {
-            return Err(bad(
-                "duration_s",
-                self.duration_s,
-                "must lie in (0, 3600] s",
-            ));
-        }
+        bounds::check_all(
+            "",
+            SIM_BOUNDS,
+            &[
+                ("mu", self.mu),
+                ("dt_s", self.dt_s),
+                ("duration_s", self.duration_s),
+                ("planner_period_s", self.planner_period_s),
+                ("log_period_s", self.log_period_s),
+                ("field_log_period_s", self.field_log_period_s),
+                ("safety_period_s", self.safety_period_s),
+            ],
+        )?;
         for (name, value) in [
+            ("duration_s", self.duration_s),
             ("planner_period_s", self.planner_period_s),
             ("log_period_s", self.log_period_s),
             ("field_log_period_s", self.field_log_period_s),
             ("safety_period_s", self.safety_period_s),
         ] {
-            if !(value.is_finite() && value >= self.dt_s && value <= 10.0) {
-                return Err(bad(
+            if value < self.dt_s {
+                return Err(SimError::invalid(
                     name,
                     value,
-                    &format!("must lie in [dt_s = {}, 10] s", self.dt_s),
+                    format!("must be at least one physics step, dt_s = {} s", self.dt_s),
                 ));
             }
         }
@@ -161,8 +185,12 @@ fn default_true() -> bool {
 
 /// Checks the vehicle list against the configuration; the error names the vehicle and field.
 pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<(), SimError> {
-    if specs.is_empty() {
-        return Err(SimError::InvalidScenario("no vehicles".into()));
+    if specs.is_empty() || specs.len() > MAX_VEHICLES {
+        return Err(SimError::invalid(
+            "vehicles",
+            specs.len() as f64,
+            format!("a scenario needs 1 to {MAX_VEHICLES} vehicles"),
+        ));
     }
     for (i, spec) in specs.iter().enumerate() {
         if specs[..i].iter().any(|other| other.name == spec.name) {
@@ -182,20 +210,27 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
         if let Driver::Prescribed { speed_profile, .. } = &spec.driver {
             speed_profile.validate(&field("driver.prescribed"))?;
         }
-        let ranges = [
-            ("x_m", spec.x_m, config.road.start_x_m, config.road.end_x_m),
-            ("y_offset_m", spec.y_offset_m, -1.0, 1.0),
-            ("speed_mps", spec.speed_mps, 0.0, 60.0),
-            ("target_speed_mps", spec.target_speed_mps, 0.5, 60.0),
-        ];
-        for (name, value, lo, hi) in ranges {
-            if !(value.is_finite() && value >= lo && value <= hi) {
-                return Err(SimError::InvalidParameter(InvalidParameter::new(
-                    field(name),
-                    value,
-                    format!("must lie in [{lo}, {hi}]"),
-                )));
-            }
+        bounds::check_all(
+            &format!("vehicles[{}]", spec.name),
+            VEHICLE_BOUNDS,
+            &[
+                ("y_offset_m", spec.y_offset_m),
+                ("speed_mps", spec.speed_mps),
+                ("target_speed_mps", spec.target_speed_mps),
+            ],
+        )?;
+        if !(spec.x_m.is_finite()
+            && spec.x_m >= config.road.start_x_m
+            && spec.x_m <= config.road.end_x_m)
+        {
+            return Err(SimError::invalid(
+                field("x_m"),
+                spec.x_m,
+                format!(
+                    "must lie on the road, in [road.start_x_m, road.end_x_m] = [{}, {}] m",
+                    config.road.start_x_m, config.road.end_x_m
+                ),
+            ));
         }
     }
     Ok(())

@@ -16,7 +16,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{InvalidParameter, SimError};
+use mergesim_types::{Bound, bounds};
+
+use crate::error::SimError;
 
 /// IDM parameters. Defaults: the original paper's highway set (Treiber et al. 2000, Table I),
 /// except the desired speed, which is each vehicle's `target_speed_mps`.
@@ -56,37 +58,33 @@ impl Default for IdmParams {
     }
 }
 
+/// Allowed ranges of the IDM parameters (README "Limits").
+pub const IDM_BOUNDS: &[Bound] = &[
+    Bound::closed("max_accel_mps2", 0.01, 20.0, "m/s²"),
+    Bound::closed("comfortable_decel_mps2", 0.01, 20.0, "m/s²"),
+    Bound::closed("time_headway_s", 0.0, 10.0, "s"),
+    Bound::closed("min_gap_m", 0.0, 50.0, "m"),
+    Bound::closed("accel_exponent", 0.1, 20.0, ""),
+    Bound::closed("max_decel_mps2", 0.1, 30.0, "m/s²"),
+    Bound::closed("corridor_half_width_m", 0.1, 10.0, "m"),
+];
+
 impl IdmParams {
-    /// Checks every field; the error names it (`idm.<field>`).
+    /// Checks every field against [`IDM_BOUNDS`]; the error names it (`idm.<field>`).
     pub fn validate(&self) -> Result<(), SimError> {
-        let fields = [
-            ("max_accel_mps2", self.max_accel_mps2, 0.01, 20.0),
-            (
-                "comfortable_decel_mps2",
-                self.comfortable_decel_mps2,
-                0.01,
-                20.0,
-            ),
-            ("time_headway_s", self.time_headway_s, 0.0, 10.0),
-            ("min_gap_m", self.min_gap_m, 0.0, 50.0),
-            ("accel_exponent", self.accel_exponent, 0.1, 20.0),
-            ("max_decel_mps2", self.max_decel_mps2, 0.1, 30.0),
-            (
-                "corridor_half_width_m",
-                self.corridor_half_width_m,
-                0.1,
-                10.0,
-            ),
-        ];
-        for (name, value, lo, hi) in fields {
-            if !(value.is_finite() && value >= lo && value <= hi) {
-                return Err(SimError::InvalidParameter(InvalidParameter::new(
-                    format!("idm.{name}"),
-                    value,
-                    format!("must lie in [{lo}, {hi}]"),
-                )));
-            }
-        }
+        bounds::check_all(
+            "idm",
+            IDM_BOUNDS,
+            &[
+                ("max_accel_mps2", self.max_accel_mps2),
+                ("comfortable_decel_mps2", self.comfortable_decel_mps2),
+                ("time_headway_s", self.time_headway_s),
+                ("min_gap_m", self.min_gap_m),
+                ("accel_exponent", self.accel_exponent),
+                ("max_decel_mps2", self.max_decel_mps2),
+                ("corridor_half_width_m", self.corridor_half_width_m),
+            ],
+        )?;
         Ok(())
     }
 }

@@ -8,7 +8,9 @@ use std::collections::BTreeMap;
 use planner::{SharedLocalPath, VehicleId};
 use serde::{Deserialize, Serialize};
 
-use crate::error::{InvalidParameter, SimError};
+use mergesim_types::{Bound, bounds};
+
+use crate::error::SimError;
 use crate::rng::SplitMix64;
 
 /// Communication parameters.
@@ -36,38 +38,26 @@ impl Default for V2vParams {
     }
 }
 
+/// Allowed ranges of the V2V parameters (README "Limits").
+pub const V2V_BOUNDS: &[Bound] = &[
+    Bound::closed("latency_s", 0.0, 10.0, "s"),
+    Bound::closed("drop_probability", 0.0, 1.0, ""),
+    Bound::closed("broadcast_period_s", 0.0, 10.0, "s"),
+    Bound::above("stale_after_s", 0.0, 60.0, "s"),
+];
+
 impl V2vParams {
-    /// Checks every field; the error names it.
+    /// Checks every field against [`V2V_BOUNDS`]; the error names it.
     pub fn validate(&self) -> Result<(), SimError> {
-        let check = |name: &str, value: f64, ok: bool, range: &str| {
-            if value.is_finite() && ok {
-                Ok(())
-            } else {
-                Err(SimError::InvalidParameter(InvalidParameter::new(
-                    format!("v2v.{name}"),
-                    value,
-                    format!("must be finite and {range}"),
-                )))
-            }
-        };
-        check("latency_s", self.latency_s, self.latency_s >= 0.0, ">= 0")?;
-        check(
-            "drop_probability",
-            self.drop_probability,
-            (0.0..=1.0).contains(&self.drop_probability),
-            "in [0, 1]",
-        )?;
-        check(
-            "broadcast_period_s",
-            self.broadcast_period_s,
-            self.broadcast_period_s >= 0.0,
-            ">= 0",
-        )?;
-        check(
-            "stale_after_s",
-            self.stale_after_s,
-            self.stale_after_s > 0.0,
-            "> 0",
+        bounds::check_all(
+            "v2v",
+            V2V_BOUNDS,
+            &[
+                ("latency_s", self.latency_s),
+                ("drop_probability", self.drop_probability),
+                ("broadcast_period_s", self.broadcast_period_s),
+                ("stale_after_s", self.stale_after_s),
+            ],
         )?;
         Ok(())
     }

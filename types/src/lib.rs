@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod behaviour;
+pub mod bounds;
 pub mod error;
 pub mod grid;
 pub mod path;
@@ -14,6 +15,7 @@ pub mod road;
 pub mod vehicle;
 
 pub use behaviour::{Behaviour, BehaviourError, Decision, Observation};
+pub use bounds::Bound;
 pub use error::InvalidParameter;
 pub use grid::{GridSpec, MAX_GRID_CELLS};
 pub use path::{PathPoint, SharedLocalPath, TimedWaypoint};

@@ -17,6 +17,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::bounds::Bound;
 use crate::error::InvalidParameter;
 
 /// Which lane a vehicle starts in.
@@ -60,31 +61,48 @@ impl Default for MergeRoad {
     }
 }
 
+/// Allowed ranges of the road's fields (README "Limits"): lateral positions within ±1 km and
+/// longitudinal ones within ±10 km of the origin, where Rapier's single precision still resolves
+/// millimetres; a merge section of 10 m to 2 km.
+pub const ROAD_BOUNDS: &[Bound] = &[
+    Bound::closed("lane_width_m", 2.0, 6.0, "m"),
+    Bound::closed("y_bottom_m", -1000.0, 1000.0, "m"),
+    Bound::closed("merge_start_x_m", -10_000.0, 10_000.0, "m"),
+    Bound::closed("merge_end_x_m", -10_000.0, 10_000.0, "m"),
+    Bound::closed("start_x_m", -10_000.0, 10_000.0, "m"),
+    Bound::closed("end_x_m", -10_000.0, 10_000.0, "m"),
+];
+
+/// Shortest and longest merge section (m).
+pub const MERGE_SECTION_LENGTH_M: [f64; 2] = [10.0, 2000.0];
+
 impl MergeRoad {
-    /// Checks every field; the error names the field and its value.
+    /// Checks every field against [`ROAD_BOUNDS`] and the fields against each other; the error
+    /// names the field and its value.
     pub fn validate(&self) -> Result<(), InvalidParameter> {
-        let finite = [
-            ("lane_width_m", self.lane_width_m),
-            ("y_bottom_m", self.y_bottom_m),
-            ("merge_start_x_m", self.merge_start_x_m),
-            ("merge_end_x_m", self.merge_end_x_m),
-            ("start_x_m", self.start_x_m),
-            ("end_x_m", self.end_x_m),
-        ];
-        for (name, value) in finite {
-            if !value.is_finite() {
-                return Err(InvalidParameter::new(
-                    format!("road.{name}"),
-                    value,
-                    "must be finite",
-                ));
-            }
-        }
-        if !(self.lane_width_m >= 2.0 && self.lane_width_m <= 6.0) {
+        crate::bounds::check_all(
+            "road",
+            ROAD_BOUNDS,
+            &[
+                ("lane_width_m", self.lane_width_m),
+                ("y_bottom_m", self.y_bottom_m),
+                ("merge_start_x_m", self.merge_start_x_m),
+                ("merge_end_x_m", self.merge_end_x_m),
+                ("start_x_m", self.start_x_m),
+                ("end_x_m", self.end_x_m),
+            ],
+        )?;
+        let merge_length_m = self.merge_end_x_m - self.merge_start_x_m;
+        if merge_length_m > 0.0
+            && !(MERGE_SECTION_LENGTH_M[0]..=MERGE_SECTION_LENGTH_M[1]).contains(&merge_length_m)
+        {
             return Err(InvalidParameter::new(
-                "road.lane_width_m",
-                self.lane_width_m,
-                "must lie in [2, 6] m",
+                "road.merge_end_x_m",
+                self.merge_end_x_m,
+                format!(
+                    "the merge section (road.merge_start_x_m = {} to here) must be {} to {} m long",
+                    self.merge_start_x_m, MERGE_SECTION_LENGTH_M[0], MERGE_SECTION_LENGTH_M[1]
+                ),
             ));
         }
         if self.start_x_m >= self.merge_start_x_m {

@@ -15,6 +15,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::controls::Controls;
+use mergesim_types::{Bound, bounds};
+
 use crate::error::VehicleError;
 use crate::kinematics::Kinematics;
 use crate::params::VehicleParams;
@@ -70,42 +72,42 @@ impl Default for TrackerParams {
     }
 }
 
+/// Allowed ranges of the tracker's parameters (README "Limits").
+pub const TRACKER_BOUNDS: &[Bound] = &[
+    Bound::closed("lookahead_min_m", 0.1, 100.0, "m"),
+    Bound::closed("lookahead_time_s", 0.0, 5.0, "s"),
+    Bound::closed("lookahead_max_m", 0.1, 200.0, "m"),
+    Bound::closed("speed_kp_per_s", 0.0, 100.0, "1/s"),
+    Bound::closed("speed_ki_per_s2", 0.0, 100.0, "1/s²"),
+    Bound::closed("speed_kd", 0.0, 10.0, ""),
+    Bound::closed("speed_integral_band_mps", 0.0, 20.0, "m/s"),
+    Bound::above("max_accel_mps2", 0.0, 20.0, "m/s²"),
+    Bound::above("max_decel_mps2", 0.0, 30.0, "m/s²"),
+    Bound::closed("friction_coefficient", 0.05, 2.0, ""),
+    Bound::closed("stop_speed_mps", 0.0, 5.0, "m/s"),
+];
+
 impl TrackerParams {
-    /// Checks every field; the error names the field and its value.
+    /// Checks every field against [`TRACKER_BOUNDS`] and the look-ahead range; the error names
+    /// the field and its value.
     pub fn validate(&self) -> Result<(), VehicleError> {
-        let positive = [
-            ("lookahead_min_m", self.lookahead_min_m),
-            ("lookahead_max_m", self.lookahead_max_m),
-            ("max_accel_mps2", self.max_accel_mps2),
-            ("max_decel_mps2", self.max_decel_mps2),
-            ("friction_coefficient", self.friction_coefficient),
-        ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(VehicleError::invalid(
-                    format!("tracker.{name}"),
-                    value,
-                    "must be finite and > 0",
-                ));
-            }
-        }
-        let non_negative = [
-            ("lookahead_time_s", self.lookahead_time_s),
-            ("speed_kp_per_s", self.speed_kp_per_s),
-            ("speed_ki_per_s2", self.speed_ki_per_s2),
-            ("speed_kd", self.speed_kd),
-            ("speed_integral_band_mps", self.speed_integral_band_mps),
-            ("stop_speed_mps", self.stop_speed_mps),
-        ];
-        for (name, value) in non_negative {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(VehicleError::invalid(
-                    format!("tracker.{name}"),
-                    value,
-                    "must be finite and >= 0",
-                ));
-            }
-        }
+        bounds::check_all(
+            "tracker",
+            TRACKER_BOUNDS,
+            &[
+                ("lookahead_min_m", self.lookahead_min_m),
+                ("lookahead_time_s", self.lookahead_time_s),
+                ("lookahead_max_m", self.lookahead_max_m),
+                ("speed_kp_per_s", self.speed_kp_per_s),
+                ("speed_ki_per_s2", self.speed_ki_per_s2),
+                ("speed_kd", self.speed_kd),
+                ("speed_integral_band_mps", self.speed_integral_band_mps),
+                ("max_accel_mps2", self.max_accel_mps2),
+                ("max_decel_mps2", self.max_decel_mps2),
+                ("friction_coefficient", self.friction_coefficient),
+                ("stop_speed_mps", self.stop_speed_mps),
+            ],
+        )?;
         if self.lookahead_max_m < self.lookahead_min_m {
             return Err(VehicleError::invalid(
                 "tracker.lookahead_max_m",

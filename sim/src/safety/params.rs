@@ -1,6 +1,6 @@
 //! Thresholds of the safety metrics, and the errors of the safety checks.
 
-use mergesim_types::{InvalidParameter, VehicleId};
+use mergesim_types::{Bound, InvalidParameter, VehicleId, bounds};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -37,38 +37,28 @@ impl Default for SafetyParams {
     }
 }
 
+/// Allowed ranges of the safety thresholds (README "Limits").
+pub const SAFETY_BOUNDS: &[Bound] = &[
+    Bound::above("ttc_threshold_s", 0.0, 60.0, "s"),
+    Bound::above("ttc_horizon_s", 0.0, 60.0, "s"),
+    Bound::closed("contact_tolerance_m", 0.0, 0.1, "m"),
+    Bound::closed("near_miss_gap_m", 0.0, 10.0, "m"),
+];
+
 impl SafetyParams {
-    /// Checks every field; the error names the field.
+    /// Checks every field against [`SAFETY_BOUNDS`] and the horizon against the threshold; the
+    /// error names the field.
     pub fn validate(&self) -> Result<(), SafetyError> {
-        let positive = [
-            ("ttc_threshold_s", self.ttc_threshold_s),
-            ("ttc_horizon_s", self.ttc_horizon_s),
-        ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(SafetyError::InvalidParameter(InvalidParameter::new(
-                    format!("safety.{name}"),
-                    value,
-                    "must be finite and > 0",
-                )));
-            }
-        }
-        if !(self.contact_tolerance_m.is_finite()
-            && (0.0..=0.1).contains(&self.contact_tolerance_m))
-        {
-            return Err(SafetyError::InvalidParameter(InvalidParameter::new(
-                "safety.contact_tolerance_m",
-                self.contact_tolerance_m,
-                "must lie in [0, 0.1] m",
-            )));
-        }
-        if !(self.near_miss_gap_m.is_finite() && self.near_miss_gap_m >= 0.0) {
-            return Err(SafetyError::InvalidParameter(InvalidParameter::new(
-                "safety.near_miss_gap_m",
-                self.near_miss_gap_m,
-                "must be finite and >= 0",
-            )));
-        }
+        bounds::check_all(
+            "safety",
+            SAFETY_BOUNDS,
+            &[
+                ("ttc_threshold_s", self.ttc_threshold_s),
+                ("ttc_horizon_s", self.ttc_horizon_s),
+                ("contact_tolerance_m", self.contact_tolerance_m),
+                ("near_miss_gap_m", self.near_miss_gap_m),
+            ],
+        )?;
         if self.ttc_horizon_s < self.ttc_threshold_s {
             return Err(SafetyError::InvalidParameter(InvalidParameter::new(
                 "safety.ttc_horizon_s",
