@@ -1,6 +1,8 @@
 //! One library entry for running a scenario: what `merge_sim run`, `compare`, `sweep` and `grid`,
 //! the integration tests and the benchmarks all call, so a run means the same thing everywhere.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use scenarios::Scenario;
@@ -20,6 +22,9 @@ pub struct InstanceOptions {
     pub seed: Option<u64>,
     /// Keep the time series (`--csv`, figures).
     pub keep_time_series: bool,
+    /// Stop the run (with [`sim::SimError::Interrupted`]) once this flag is set, e.g. by a
+    /// SIGINT/SIGTERM handler.
+    pub interrupt: Option<Arc<AtomicBool>>,
 }
 
 /// Why a run did not finish.
@@ -89,7 +94,14 @@ pub fn run_instance(
     )
     .map_err(RunError::Setup)?;
     let started = Instant::now();
-    let outcome = world.run(progress).map_err(RunError::Run)?;
+    let interrupt = options.interrupt.clone();
+    let outcome = world
+        .run_until(progress, || {
+            interrupt
+                .as_ref()
+                .is_some_and(|flag| flag.load(Ordering::Relaxed))
+        })
+        .map_err(RunError::Run)?;
     let wall_time_s = started.elapsed().as_secs_f64();
     let label = planner_label(scenario, options.planner.as_deref());
     let summary = RunSummary::new(

@@ -169,7 +169,8 @@ pub struct GridRow {
     pub planner: String,
     /// Instance index (0 for the nominal scenario).
     pub instance: u64,
-    /// Seed of the instance; null for the nominal scenario.
+    /// Seed of the instance (a string in JSON); null for the nominal scenario.
+    #[serde(with = "crate::exact_seed::option")]
     pub seed: Option<u64>,
     /// Collision episodes (vehicle–vehicle and road edge); null if the run failed.
     pub collisions: Option<u64>,
@@ -178,6 +179,9 @@ pub struct GridRow {
     /// Per-vehicle figures (empty if the run failed).
     pub vehicles: Vec<VehicleFigures>,
 }
+
+/// Most instances a grid cell may run (the default grid runs 36 cells × planners of them).
+pub const MAX_GRID_RUNS: u64 = 10_000;
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -194,6 +198,9 @@ pub struct GridPlan {
     pub seed: u64,
     /// Worker threads (None: one per core).
     pub threads: Option<usize>,
+    /// Once set (e.g. by a signal handler), no run starts and running ones stop; `run_grid`
+    /// then returns an error instead of a partial grid.
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// Runs of one (cell, planner) job.
@@ -226,13 +233,18 @@ fn figures(outcome: &sim::RunOutcome) -> Vec<VehicleFigures> {
         .collect()
 }
 
-fn run_job(scenario: &Scenario, job: &Job) -> GridRow {
+fn run_job(
+    scenario: &Scenario,
+    job: &Job,
+    interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+) -> GridRow {
     let mut cell_scenario = scenario.clone();
     cell_scenario.sim.planner = job.cell.apply(&scenario.sim.planner);
     let options = InstanceOptions {
         planner: Some(job.planner.name().to_string()),
         seed: job.seed,
         keep_time_series: false,
+        interrupt,
     };
     let result = run_quietly(&cell_scenario, &options).map(|finished| finished.outcome);
     let (collisions, error, vehicles) = match result {
@@ -267,7 +279,8 @@ pub struct GridOutcome {
     pub planners: Vec<String>,
     /// Instances per cell (0: nominal only).
     pub runs: u64,
-    /// Sweep seed.
+    /// Sweep seed (a string in JSON).
+    #[serde(with = "crate::exact_seed")]
     pub seed: u64,
     /// Every run, in cell, planner, instance order.
     pub rows: Vec<GridRow>,
@@ -326,12 +339,19 @@ pub fn run_grid(plan: &GridPlan, on_run_done: &(dyn Fn() + Sync)) -> Result<Grid
     let ran: Vec<GridRow> = pool.install(|| {
         jobs.par_iter()
             .map(|job| {
-                let row = run_job(&plan.scenario, job);
+                let row = run_job(&plan.scenario, job, plan.interrupt.clone());
                 on_run_done();
                 row
             })
             .collect()
     });
+    if plan
+        .interrupt
+        .as_ref()
+        .is_some_and(|flag| flag.load(std::sync::atomic::Ordering::Relaxed))
+    {
+        return Err("interrupted".into());
+    }
     // Every cell gets a row for every planner and instance (shared rows copied in).
     let mut rows = Vec::new();
     for cell in &cells {
@@ -400,6 +420,7 @@ mod tests {
             runs: 0,
             seed: 0,
             threads: None,
+            interrupt: None,
         };
         // PF-CS: 16 cells (τ_I shared), PF-ISO: 48.
         assert_eq!(job_count(&plan), 64);

@@ -6,9 +6,11 @@
 //! [`scenarios`] (scenario files).
 #![warn(missing_docs)]
 
+pub mod exact_seed;
 pub mod experiment;
 pub mod grid;
 pub mod grid_plot;
+pub mod limits;
 pub mod output;
 pub mod plots;
 pub mod report;

@@ -12,7 +12,9 @@ pub struct RunSummary {
     pub planner: String,
     /// Planner parameter set (`paper` or `mergesim`).
     pub params: String,
-    /// Seed of the run (null for the nominal scenario).
+    /// Seed of the run (null for the nominal scenario), as a string (exact in every JSON
+    /// reader; integers are read too).
+    #[serde(with = "crate::exact_seed::option")]
     pub seed: Option<u64>,
     /// Simulated time (s).
     pub duration_s: f64,

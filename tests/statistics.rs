@@ -27,7 +27,7 @@ fn sweep(planner: PlannerKind) -> SweepSummary {
         seed: SEED,
         shard: Shard::WHOLE,
     };
-    run_sweep(&plan, &SweepOptions::default(), &|| {})
+    run_sweep(&plan, &SweepOptions::default(), &|_| {})
         .unwrap()
         .summary
 }
@@ -165,7 +165,7 @@ fn pf_iso_pred_does_not_race_where_the_equilibria_meet() {
             seed: 42,
             shard: Shard::WHOLE,
         };
-        let summary = run_sweep(&plan, &SweepOptions::default(), &|| {})
+        let summary = run_sweep(&plan, &SweepOptions::default(), &|_| {})
             .unwrap()
             .summary;
         assert_eq!(summary.diverged, 0, "{name}");

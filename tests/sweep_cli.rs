@@ -20,12 +20,20 @@ fn without_wall_time(mut v: Value) -> Value {
     v
 }
 
+/// The JSONL's rows in instance order (the file holds them in completion order).
 fn jsonl_rows(path: &Path) -> Vec<Value> {
-    std::fs::read_to_string(path)
+    let mut rows: Vec<Value> = std::fs::read_to_string(path)
         .unwrap()
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
-        .collect()
+        .collect();
+    rows.sort_by_key(|r| r["instance"].as_u64().unwrap());
+    rows
+}
+
+/// A seed as the JSON files write it: a string of digits, exact in every reader.
+fn seed_of(row: &Value) -> u64 {
+    row["seed"].as_str().unwrap().parse().unwrap()
 }
 
 fn p(path: &Path) -> &str {
@@ -140,17 +148,14 @@ fn sharded_sweep_merges_into_exactly_the_unsharded_one_and_rows_replay() {
     assert_eq!(strip(&shard_rows), strip(&whole_rows));
 
     // Seeds are distinct, and any row replays alone with `run --seed`.
-    let seeds: Vec<u64> = whole_rows
-        .iter()
-        .map(|r| r["seed"].as_u64().unwrap())
-        .collect();
+    let seeds: Vec<u64> = whole_rows.iter().map(seed_of).collect();
     let mut distinct = seeds.clone();
     distinct.sort_unstable();
     distinct.dedup();
     assert_eq!(distinct.len(), seeds.len());
     let row = &whole_rows[5];
     let replay = dir.join("replay.json");
-    let seed = row["seed"].as_u64().unwrap().to_string();
+    let seed = seed_of(row).to_string();
     let out = merge_sim(
         &[
             "run",

@@ -23,7 +23,7 @@ use sim::rng::SplitMix64;
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum Distribution {
     /// `nominal + U[lo, hi]`.
-    Uniform([f64; 2]),
+    Uniform(#[serde(deserialize_with = "exactly_two")] [f64; 2]),
     /// `nominal + N(mean_offset, std²)` truncated to `clip`.
     Normal(NormalOffset),
 }
@@ -38,7 +38,20 @@ pub struct NormalOffset {
     /// Standard deviation of the untruncated normal (≥ 0; 0 gives `mean_offset`).
     pub std: f64,
     /// Truncation window `[lo, hi]` of the offset; must contain `mean_offset`.
+    #[serde(deserialize_with = "exactly_two")]
     pub clip: [f64; 2],
+}
+
+/// Reads `[lo, hi]`: exactly two numbers (serde's arrays would silently ignore a third).
+fn exactly_two<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<[f64; 2], D::Error> {
+    let values = Vec::<f64>::deserialize(deserializer)?;
+    match values.as_slice() {
+        [lo, hi] => Ok([*lo, *hi]),
+        _ => Err(serde::de::Error::custom(format!(
+            "expected exactly two numbers [lo, hi], got {} ({values:?})",
+            values.len()
+        ))),
+    }
 }
 
 impl Distribution {

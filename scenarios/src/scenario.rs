@@ -108,6 +108,10 @@ pub enum ScenarioError {
     },
 }
 
+/// Overshoot allowed over a vehicle's highest nominal speed when checking that the road is long
+/// enough for the run (the trackers hold speeds within a few per cent of their targets).
+pub const ROAD_END_SPEED_ALLOWANCE: f64 = 0.1;
+
 impl Scenario {
     /// Loads a built-in by name, or else a TOML file by path.
     pub fn load(name_or_path: &str) -> Result<Self, ScenarioError> {
@@ -314,17 +318,55 @@ impl Scenario {
                     .vehicle_entry_path(&v.name, "y_offset_m")
                     .or_else(|| self.nominal_path(&format!("vehicles[{}].y_offset_m", v.name)));
                 let lateral = why.starts_with("its body spans y");
+                let field = format!(
+                    "vehicles[{}].{}",
+                    v.name,
+                    if lateral { "y_offset_m" } else { "x_m" }
+                );
                 return Err(ScenarioError::Invalid {
                     origin: origin.to_string(),
                     line: at(if lateral { y_entry } else { x_entry() }),
-                    field: Some(format!(
-                        "vehicles[{}].{}",
-                        v.name,
-                        if lateral { "y_offset_m" } else { "x_m" }
-                    )),
                     message: format!(
-                        "vehicles[{}] must start on the road, including randomisation: {why}",
+                        "{field}: vehicles[{}] must start on the road, including \
+                         randomisation: {why}",
                         v.name
+                    ),
+                    field: Some(field),
+                });
+            }
+            // The road must be long enough for the whole run: every vehicle driving the whole
+            // duration at the highest speed it starts at, aims at or is prescribed, plus
+            // ROAD_END_SPEED_ALLOWANCE for overshoot, stays on it.
+            let prescribed_max_mps = match &v.driver {
+                sim::Driver::Prescribed { speed_profile, .. } => speed_profile
+                    .points
+                    .iter()
+                    .map(|p| p[1])
+                    .fold(0.0, f64::max),
+                _ => 0.0,
+            };
+            let top_speed_mps = (v.speed_mps + b.speed_mps[1])
+                .max(v.target_speed_mps + b.target_speed_mps[1])
+                .max(prescribed_max_mps)
+                * (1.0 + ROAD_END_SPEED_ALLOWANCE);
+            let reach_m = x[1] + top_speed_mps * self.sim.duration_s;
+            if reach_m > road.end_x_m {
+                return Err(ScenarioError::Invalid {
+                    origin: origin.to_string(),
+                    line: at(self.nominal_path("road.end_x_m")),
+                    field: Some("road.end_x_m".into()),
+                    message: format!(
+                        "road.end_x_m = {}: too short for vehicles[{}], which can reach x = {:.1} \
+                         m in duration_s = {} s (front at {:.1} m, {:.2} m/s = its highest \
+                         initial, target or prescribed speed including randomisation, + {:.0} \
+                         %); lengthen the road or shorten the run",
+                        road.end_x_m,
+                        v.name,
+                        reach_m,
+                        self.sim.duration_s,
+                        x[1],
+                        top_speed_mps,
+                        100.0 * ROAD_END_SPEED_ALLOWANCE
                     ),
                 });
             }

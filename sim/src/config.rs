@@ -86,6 +86,18 @@ pub const VEHICLE_BOUNDS: &[Bound] = &[
 /// Most vehicles a scenario may hold (every vehicle plans against every other).
 pub const MAX_VEHICLES: usize = 200;
 
+/// Most vehicle physics steps of one run (vehicles × duration_s / dt_s): at ≈ 2 µs per vehicle
+/// and step, about 7 minutes of physics.
+pub const MAX_VEHICLE_STEPS: f64 = 2e8;
+
+/// Most planning cycles of one run (vehicles × duration_s / planner_period_s): at ≈ 0.2–5 ms
+/// per cycle, at most a few hours in the densest traffic.
+pub const MAX_PLANNING_CYCLES: f64 = 2e6;
+
+/// Most pair checks of the safety monitor in one run (vehicle pairs × duration_s /
+/// safety_period_s).
+pub const MAX_PAIR_CHECKS: f64 = 1e9;
+
 impl SimConfig {
     /// Checks every field against its bounds and the periods against the physics step; the
     /// error names the field and its value.
@@ -191,6 +203,45 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
             specs.len() as f64,
             format!("a scenario needs 1 to {MAX_VEHICLES} vehicles"),
         ));
+    }
+    // Bounded work: a run that cannot finish in reasonable time is refused before it starts.
+    let vehicles = specs.len() as f64;
+    let pairs = vehicles * (vehicles - 1.0) / 2.0;
+    for (what, amount, limit, field, value) in [
+        (
+            "vehicle physics steps (vehicles × duration_s / dt_s)",
+            vehicles * config.duration_s / config.dt_s,
+            MAX_VEHICLE_STEPS,
+            "dt_s",
+            config.dt_s,
+        ),
+        (
+            "planning cycles (vehicles × duration_s / planner_period_s)",
+            vehicles * config.duration_s / config.planner_period_s,
+            MAX_PLANNING_CYCLES,
+            "planner_period_s",
+            config.planner_period_s,
+        ),
+        (
+            "safety pair checks (vehicle pairs × duration_s / safety_period_s)",
+            pairs * config.duration_s / config.safety_period_s,
+            MAX_PAIR_CHECKS,
+            "safety_period_s",
+            config.safety_period_s,
+        ),
+    ] {
+        if amount > limit {
+            return Err(SimError::invalid(
+                field,
+                value,
+                format!(
+                    "with duration_s = {} s and {} vehicles the run needs {amount:.3e} {what}, \
+                     more than the limit {limit:.0e}: lengthen {field} or shorten duration_s",
+                    config.duration_s,
+                    specs.len()
+                ),
+            ));
+        }
     }
     for (i, spec) in specs.iter().enumerate() {
         if specs[..i].iter().any(|other| other.name == spec.name) {

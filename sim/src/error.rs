@@ -50,6 +50,26 @@ pub enum SimError {
         /// What was wrong.
         what: String,
     },
+    /// A vehicle reached the end of the road before the run ended (the scenario loader refuses
+    /// roads too short for the run; a `World` built directly can still meet this).
+    #[error(
+        "vehicle {vehicle} reached the end of the road (road.end_x_m = {end_x_m} m) at t = {t_s} s; \
+         lengthen the road or shorten duration_s"
+    )]
+    RoadEnd {
+        /// The vehicle's name.
+        vehicle: String,
+        /// When its front passed the end (s).
+        t_s: f64,
+        /// Where the road ends (m).
+        end_x_m: f64,
+    },
+    /// The run was interrupted (a signal) before its end.
+    #[error("interrupted at t = {t_s} s")]
+    Interrupted {
+        /// Simulated time reached (s).
+        t_s: f64,
+    },
     /// Writing an output failed.
     #[error("recording: {0}")]
     Recording(String),

@@ -158,10 +158,24 @@ impl World {
     }
 
     /// Runs to the end; `progress(fraction)` is called about a hundred times.
-    pub fn run(mut self, mut progress: impl FnMut(f64)) -> Result<RunOutcome, SimError> {
+    pub fn run(self, progress: impl FnMut(f64)) -> Result<RunOutcome, SimError> {
+        self.run_until(progress, || false)
+    }
+
+    /// [`Self::run`], stopping with [`SimError::Interrupted`] as soon as `interrupted()` is true
+    /// (checked before every physics step; e.g. a flag set by a signal handler). The recording
+    /// of an interrupted run is discarded with the world.
+    pub fn run_until(
+        mut self,
+        mut progress: impl FnMut(f64),
+        interrupted: impl Fn() -> bool,
+    ) -> Result<RunOutcome, SimError> {
         let total = self.total_steps();
         let report_every = (total / 100).max(1);
         while self.step_index < total {
+            if interrupted() {
+                return Err(SimError::Interrupted { t_s: self.time_s() });
+            }
             self.step()?;
             if self.step_index.is_multiple_of(report_every) {
                 progress(self.step_index as f64 / total as f64);
@@ -214,6 +228,14 @@ impl World {
                 .collect();
             for (agent, kin) in self.agents.iter().zip(&kins) {
                 check_finite(t_s, &agent.spec.name, kin)?;
+                let front_m = kin.x_m + 0.5 * agent.vehicle.params().length_m;
+                if front_m > self.config.road.end_x_m {
+                    return Err(SimError::RoadEnd {
+                        vehicle: agent.spec.name.clone(),
+                        t_s,
+                        end_x_m: self.config.road.end_x_m,
+                    });
+                }
             }
             let bodies = self.body_states(&kins);
             if need_safety {

@@ -59,6 +59,14 @@ pub fn merge_shards(parts: Vec<(String, SweepSummary)>) -> Result<SweepSummary, 
             )));
         }
         *slot = Some(origin.as_str());
+        if part.missing_runs > 0 {
+            return Err(SweepError::Invalid(format!(
+                "{origin}: shard {} is incomplete ({} of its runs missing: it was interrupted); \
+                 finish it with the same `merge_sim sweep` command plus --resume (and its \
+                 --jsonl file), then merge",
+                part.shard, part.missing_runs
+            )));
+        }
         let range = part.shard.instances(part.total_runs);
         let instances: Vec<u64> = part.samples.iter().map(|r| r.instance).collect();
         if instances != range.clone().collect::<Vec<_>>()

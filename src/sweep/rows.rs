@@ -78,11 +78,16 @@ impl RunMetrics {
 }
 
 /// One run of a sweep (one JSONL line, without the wall time; one element of `samples`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+///
+/// Read strictly: a `completed` row must carry every figure, well formed (a malformed figure is
+/// an error naming the instance, never a silently "diverged" run).
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RunRow {
     /// Instance index i in `0..runs`.
     pub instance: u64,
-    /// The run's seed, [`instance_seed`](super::instance_seed)`(K, i)`: `merge_sim run --seed <seed>` replays it.
+    /// The run's seed, [`instance_seed`](super::instance_seed)`(K, i)`: `merge_sim run --seed
+    /// <seed>` replays it. A string in JSON (exact in every reader); integers are read too.
+    #[serde(with = "crate::exact_seed")]
     pub seed: u64,
     /// How it ended.
     pub status: RunStatus,
@@ -94,12 +99,76 @@ pub struct RunRow {
     pub metrics: Option<RunMetrics>,
 }
 
-/// A JSONL line: a row with its context and wall time.
+impl<'de> Deserialize<'de> for RunRow {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        #[derive(Deserialize)]
+        struct Raw {
+            instance: u64,
+            #[serde(with = "crate::exact_seed")]
+            seed: u64,
+            status: RunStatus,
+            #[serde(default)]
+            error: Option<String>,
+            #[serde(flatten)]
+            rest: serde_json::Map<String, serde_json::Value>,
+        }
+        let raw = Raw::deserialize(deserializer)?;
+        let metrics = match raw.status {
+            RunStatus::Completed => Some(
+                RunMetrics::deserialize(serde_json::Value::Object(raw.rest)).map_err(|e| {
+                    D::Error::custom(format!(
+                        "instance {}: a completed run with missing or malformed figures: {e}",
+                        raw.instance
+                    ))
+                })?,
+            ),
+            RunStatus::Diverged | RunStatus::Panicked => None,
+        };
+        Ok(RunRow {
+            instance: raw.instance,
+            seed: raw.seed,
+            status: raw.status,
+            error: raw.error,
+            metrics,
+        })
+    }
+}
+
+/// A JSONL line: a row with its sweep's identity and wall time.
 #[derive(Serialize)]
 pub(super) struct JsonlLine<'a> {
     pub(super) scenario: &'a str,
+    pub(super) scenario_fingerprint: &'a str,
+    pub(super) params: &'a str,
     pub(super) planner: &'a str,
+    #[serde(with = "crate::exact_seed")]
+    pub(super) sweep_seed: u64,
+    pub(super) total_runs: u64,
     #[serde(flatten)]
     pub(super) row: &'a RunRow,
     pub(super) wall_time_s: f64,
+}
+
+/// A JSONL line read back (`--resume`): the identity of its sweep, the row and its wall time.
+#[derive(Clone, Debug, Deserialize)]
+pub struct JsonlRecord {
+    /// Scenario name.
+    pub scenario: String,
+    /// Fingerprint of the nominal scenario.
+    pub scenario_fingerprint: String,
+    /// Planner parameter set.
+    pub params: String,
+    /// Planner label.
+    pub planner: String,
+    /// Sweep seed K.
+    #[serde(with = "crate::exact_seed")]
+    pub sweep_seed: u64,
+    /// Instances in the whole sweep.
+    pub total_runs: u64,
+    /// The run.
+    #[serde(flatten)]
+    pub row: RunRow,
+    /// Wall time of the run (s).
+    pub wall_time_s: f64,
 }

@@ -22,7 +22,8 @@ pub struct SweepSummary {
     pub planner: String,
     /// Planner parameter set (`paper` or `mergesim`).
     pub params: String,
-    /// Sweep seed K.
+    /// Sweep seed K (a string in JSON: exact in every reader; integers are read too).
+    #[serde(with = "crate::exact_seed")]
     pub seed: u64,
     /// Instances in the whole sweep.
     pub total_runs: u64,
@@ -30,8 +31,12 @@ pub struct SweepSummary {
     pub shard: Shard,
     /// The instances of this part, `[start, end)`.
     pub instances: [u64; 2],
-    /// Runs in this part.
+    /// Runs in this part that finished (completed or diverged).
     pub runs: u64,
+    /// Instances of this part without a row: the sweep was interrupted before they finished
+    /// (0 for a complete part; resume it with `merge_sim sweep … --resume`).
+    #[serde(default)]
+    pub missing_runs: u64,
     /// Runs that simulated to the end.
     pub completed: u64,
     /// Runs whose World returned an error or that panicked.
@@ -71,6 +76,24 @@ pub struct SweepSummary {
     pub wall_time_s: f64,
     /// The runs, in instance order.
     pub samples: Vec<RunRow>,
+}
+
+/// One JSONL line (without the newline) of a run of the sweep `identity`.
+pub fn jsonl_line(
+    identity: &SweepIdentity,
+    row: &RunRow,
+    wall_time_s: f64,
+) -> Result<String, serde_json::Error> {
+    serde_json::to_string(&JsonlLine {
+        scenario: &identity.scenario,
+        scenario_fingerprint: &identity.scenario_fingerprint,
+        params: &identity.params,
+        planner: &identity.planner,
+        sweep_seed: identity.seed,
+        total_runs: identity.total_runs,
+        row,
+        wall_time_s,
+    })
 }
 
 /// What identifies a sweep (shared by its shards).
@@ -141,6 +164,7 @@ impl SweepSummary {
             shard,
             instances: [range.start, range.end],
             runs: rows.len() as u64,
+            missing_runs: (range.end - range.start).saturating_sub(rows.len() as u64),
             completed,
             diverged: rows.len() as u64 - completed,
             panicked,
@@ -225,20 +249,28 @@ impl SweepSummary {
             opt(self.mean_min_speed_mps, 2),
             self.fallbacks,
             self.runs_with_fallbacks,
-        )
+        ) + &if self.missing_runs > 0 {
+            format!(
+                "INCOMPLETE: {} of {} runs missing (interrupted); the figures above are over the \
+                 finished runs only\n",
+                self.missing_runs,
+                self.instances[1] - self.instances[0]
+            )
+        } else {
+            String::new()
+        }
+    }
+
+    /// One JSONL line (without the newline): `row` with the sweep's identity and `wall_time_s`.
+    pub fn jsonl_line(&self, row: &RunRow, wall_time_s: f64) -> Result<String, serde_json::Error> {
+        jsonl_line(&self.identity(), row, wall_time_s)
     }
 
     /// The JSONL text of the runs (one line each, with scenario, planner and wall time).
     pub fn jsonl(&self, wall_times_s: &[f64]) -> Result<String, serde_json::Error> {
         let mut text = String::new();
         for (i, row) in self.samples.iter().enumerate() {
-            let line = JsonlLine {
-                scenario: &self.scenario,
-                planner: &self.planner,
-                row,
-                wall_time_s: wall_times_s.get(i).copied().unwrap_or(0.0),
-            };
-            text.push_str(&serde_json::to_string(&line)?);
+            text.push_str(&self.jsonl_line(row, wall_times_s.get(i).copied().unwrap_or(0.0))?);
             text.push('\n');
         }
         Ok(text)

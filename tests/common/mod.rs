@@ -26,6 +26,7 @@ pub fn simulate(
         planner: planner.map(|k| k.name().to_string()),
         seed: Some(seed),
         keep_time_series,
+        interrupt: None,
     };
     run_quietly(&nominal, &options)
         .unwrap_or_else(|e| panic!("{}: {e}", scenario.name))

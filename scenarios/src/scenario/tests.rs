@@ -165,6 +165,16 @@ fn malformed_randomisation_entries_are_named() {
             "z_m = { uniform = [-3.0, 3.0] }",
             "z_m",
         ),
+        (
+            "mu = { uniform = [-0.1, 0.1] }",
+            "mu = { uniform = [-0.1, 0.1, 0.5] }",
+            "exactly two numbers",
+        ),
+        (
+            "mu = { uniform = [-0.1, 0.1] }",
+            "mu = { normal = { std = 0.1, clip = [-0.1] } }",
+            "exactly two numbers",
+        ),
     ];
     for (from, to, needle) in cases {
         let text = urgent().replace(from, to);
@@ -274,4 +284,30 @@ fn a_draw_does_not_depend_on_which_other_values_are_randomised() {
     let (a, b) = (s.instantiate(9), fewer.instantiate(9));
     assert_eq!(a.vehicles, b.vehicles);
     assert_eq!(b.sim.mu, s.sim.mu);
+}
+
+#[test]
+fn a_body_partly_off_the_road_at_spawn_is_refused() {
+    // The ego (BMW 320i, 1.61 m wide) 1 m below the lower lane's centre (1.75 m): its body
+    // reaches y = 0.75 − 0.805 = −0.055 m, below the road edge at 0 m.
+    let text = urgent().replacen("x_m = 0.0", "x_m = 0.0\ny_offset_m = -1.0", 1);
+    assert_ne!(text, urgent(), "the built-in changed: update this test");
+    let err = Scenario::from_toml(&text, "x.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("vehicles[ego].y_offset_m") && err.contains("must start on the road"),
+        "{err}"
+    );
+    let line = line_of_text(&text, "y_offset_m = -1.0");
+    assert!(err.contains(&format!("line {line}")), "{err}");
+    // Half a body behind the road's start.
+    let text = urgent().replacen("x_m = 0.0", "x_m = -48.0", 1);
+    let err = Scenario::from_toml(&text, "x.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("vehicles[ego].x_m") && err.contains("beyond the road"),
+        "{err}"
+    );
 }

@@ -209,6 +209,11 @@ impl Recorder {
         if params.blueprint {
             builder = builder.with_default_blueprint(Self::blueprint(&params));
         }
+        // A stale temporary file (or link) of a killed process is removed, never written
+        // through.
+        if std::fs::symlink_metadata(&tmp_path).is_ok() {
+            std::fs::remove_file(&tmp_path).ok();
+        }
         let stream = builder.save(&tmp_path)?;
         stream.log_static("world", &ViewCoordinates::RIGHT_HAND_Z_UP())?;
         Ok(Self {

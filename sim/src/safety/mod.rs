@@ -54,7 +54,7 @@ pub use events::{
     CollisionEvent, EdgeContactEvent, PairInstant, PairSafety, RoadEdge, SafetyStepReport,
     SafetySummary,
 };
-pub use params::{SafetyError, SafetyParams};
+pub use params::{SAFETY_BOUNDS, SafetyError, SafetyParams};
 
 /// One straight piece of a road edge, in world coordinates.
 #[derive(Clone, Copy, Debug)]

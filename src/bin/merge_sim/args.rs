@@ -40,6 +40,9 @@ pub(crate) enum Command {
     /// Eq. 7 on/off} × {sub-steps on/off} × path time gap τ × interaction time gap τ_I, with
     /// paired differences against the first planner.
     Grid(GridArgs),
+    /// Print the allowed range of every scenario value and the limits on runs, threads and
+    /// work, as a Markdown table (the README's "Limits" section is this output).
+    Limits,
 }
 
 /// Which scenario, with which planner parameter set.
@@ -170,7 +173,7 @@ pub(crate) struct SweepArgs {
     /// Planner of every planner-driven vehicle (overrides the scenario's choice).
     #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
     pub(crate) planner: Option<PlannerKind>,
-    /// Number of randomised instances in the whole sweep (at least 1).
+    /// Number of randomised instances in the whole sweep (1 to 1000000).
     #[arg(long, value_name = "N", value_parser = parse_runs)]
     pub(crate) runs: u64,
     /// Sweep seed K: instance i runs with seed SplitMix64::derive(K, i), which `run --seed`
@@ -185,9 +188,16 @@ pub(crate) struct SweepArgs {
     /// Write the aggregate JSON here (with per-run samples, so shards can be merged).
     #[arg(long, value_name = "PATH")]
     pub(crate) json: Option<PathBuf>,
-    /// Write one JSON line per run here (instance, seed, status, figures, wall time).
+    /// Append one JSON line per run here as it finishes (the sweep's identity, instance, seed,
+    /// status, figures, wall time), flushed at once, so an interrupted sweep loses no finished
+    /// run. An existing file is refused unless --resume is given.
     #[arg(long, value_name = "PATH")]
     pub(crate) jsonl: Option<PathBuf>,
+    /// Complete an interrupted sweep: read the --jsonl file of the same sweep (same scenario,
+    /// parameters, planner, --runs, --seed and shard), run only the instances it lacks and
+    /// append them; the aggregate then equals an uninterrupted sweep's.
+    #[arg(long, requires = "jsonl")]
+    pub(crate) resume: bool,
     /// Worker threads [default: one per core].
     #[arg(long, value_name = "N", value_parser = parse_threads)]
     pub(crate) threads: Option<usize>,
@@ -257,17 +267,23 @@ pub(crate) struct GridArgs {
 }
 
 pub(crate) fn parse_runs(text: &str) -> Result<u64, String> {
+    use mergesim::sweep::MAX_RUNS;
     match text.parse::<u64>() {
-        Ok(0) => Err("must be at least 1".into()),
-        Ok(n) => Ok(n),
-        Err(_) => Err("expected a whole number of runs, at least 1".into()),
+        Ok(n) if (1..=MAX_RUNS).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "expected a whole number of runs from 1 to {MAX_RUNS} (for more, run several sweeps \
+             with different seeds)"
+        )),
     }
 }
 
 pub(crate) fn parse_threads(text: &str) -> Result<usize, String> {
+    use mergesim::sweep::MAX_THREADS;
     match text.parse::<usize>() {
-        Ok(0) | Err(_) => Err("expected a whole number of threads, at least 1".into()),
-        Ok(n) => Ok(n),
+        Ok(n) if (1..=MAX_THREADS).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "expected a whole number of threads from 1 to {MAX_THREADS}"
+        )),
     }
 }
 

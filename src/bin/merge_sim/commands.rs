@@ -1,6 +1,6 @@
 //! The subcommands: each parses nothing and prints or writes what the library returns.
 
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Seek, Write};
 use std::path::PathBuf;
 
 use anyhow::{Context, anyhow};
@@ -13,21 +13,26 @@ use crate::args::{
     CompareArgs, GridArgs, ManeuverArgs, ManeuverName, MergeResultsArgs, RunArgs, ScenarioCommand,
     SweepArgs,
 };
+use crate::signals::Interrupt;
 use crate::{
-    Failure, input, load_scenario, out, outln, run_failure, simulate, sweep_failure, write_output,
+    Failure, input, interrupted, load_scenario, out, outln, run_failure, simulate, sweep_failure,
+    write_output,
 };
 
-pub(crate) fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
+pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failure> {
+    use mergesim::output::file_name_part;
     let scenario = load_scenario(&args.source.scenario, args.source.params)?;
     let label = mergesim::sweep::planner_label(&scenario, args.planner);
     let rrd = if args.no_rrd {
         None
     } else {
-        Some(
-            args.rrd
-                .clone()
-                .unwrap_or_else(|| PathBuf::from(format!("{}_{label}.rrd", scenario.name))),
-        )
+        Some(args.rrd.clone().unwrap_or_else(|| {
+            PathBuf::from(format!(
+                "{}_{}.rrd",
+                file_name_part(&scenario.name),
+                file_name_part(&label)
+            ))
+        }))
     };
     for (path, what) in [
         (rrd.as_deref(), "--rrd"),
@@ -46,6 +51,7 @@ pub(crate) fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
         rrd.as_deref(),
         args.csv.is_some(),
         show_progress,
+        interrupt,
     )?;
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&finished.summary).map_err(run_failure)?;
@@ -86,7 +92,7 @@ pub(crate) fn cmd_run(args: &RunArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-pub(crate) fn cmd_compare(args: &CompareArgs) -> Result<(), Failure> {
+pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(), Failure> {
     let scenario = load_scenario(&args.source.scenario, args.source.params)?;
     if let Some(path) = &args.json {
         check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
@@ -105,6 +111,7 @@ pub(crate) fn cmd_compare(args: &CompareArgs) -> Result<(), Failure> {
             None,
             args.plots.is_some(),
             show_progress,
+            interrupt,
         )?;
         summaries.push(finished.summary);
         time_series.push(finished.outcome.time_series);
@@ -191,16 +198,13 @@ pub(crate) fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
     Ok(())
 }
 
-pub(crate) fn cmd_sweep(args: &SweepArgs) -> Result<(), Failure> {
-    use mergesim::sweep::{Shard, SweepOptions, SweepPlan, run_sweep};
+pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), Failure> {
+    use mergesim::sweep::{
+        Shard, SweepIdentity, SweepOptions, SweepPlan, resume::read_jsonl, run_sweep, validate,
+    };
     let scenario = load_scenario(&args.source.scenario, args.source.params)?;
-    for (path, what) in [
-        (args.json.as_deref(), "--json"),
-        (args.jsonl.as_deref(), "--jsonl"),
-    ] {
-        if let Some(path) = path {
-            check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
-        }
+    if let Some(path) = &args.json {
+        check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
     }
     let shard = match args.shard {
         Some(shard) => shard,
@@ -215,9 +219,81 @@ pub(crate) fn cmd_sweep(args: &SweepArgs) -> Result<(), Failure> {
         seed: args.seed,
         shard,
     };
+    let identity = SweepIdentity::of(&plan);
+    // The JSONL: a fresh file, or (--resume) the rows of the interrupted attempt.
+    let mut resume = Vec::new();
+    let jsonl = match &args.jsonl {
+        None => None,
+        Some(path) => {
+            let exists = std::fs::symlink_metadata(path).is_ok();
+            if exists && !args.resume {
+                return Err(input(anyhow!(
+                    "--jsonl {}: exists; pass --resume to complete the sweep it holds, or \
+                     remove it or choose another path",
+                    path.display()
+                )));
+            }
+            if exists {
+                check_output_path(path, "--jsonl").map_err(|e| input(anyhow!(e)))?;
+                let text = std::fs::read_to_string(path)
+                    .with_context(|| format!("cannot read {}", path.display()))
+                    .map_err(input)?;
+                let read = read_jsonl(&text, &path.display().to_string(), &identity)
+                    .map_err(sweep_failure)?;
+                if read.torn_last_line && !args.quiet {
+                    eprintln!(
+                        "warning: {}: the last line was cut short (the process was killed while \
+                         writing it); it is dropped and its run runs again",
+                        path.display()
+                    );
+                }
+                resume = read.runs;
+                Some((path.clone(), Some(read.complete_len)))
+            } else {
+                check_output_path(path, "--jsonl").map_err(|e| input(anyhow!(e)))?;
+                Some((path.clone(), None))
+            }
+        }
+    };
+    let options = SweepOptions {
+        threads: args.threads,
+        interrupt: Some(interrupt.flag.clone()),
+        resume,
+    };
+    // Every check before any work or any write.
+    validate(&plan, &options).map_err(sweep_failure)?;
+    let writer = match &jsonl {
+        None => None,
+        Some((path, complete_len)) => Some(std::sync::Mutex::new(open_jsonl(path, *complete_len)?)),
+    };
     let instances = shard.instances(args.runs);
+    let to_run = (instances.end - instances.start) - options.resume.len() as u64;
+    // The shard banner goes to stderr even with --quiet: a job log then says what ran.
+    eprintln!(
+        "sweep {} {}: seed {}, shard {shard} = instances {}..{} of {}{}",
+        plan.scenario.name,
+        identity.planner,
+        args.seed,
+        instances.start,
+        instances.end,
+        args.runs,
+        if options.resume.is_empty() {
+            String::new()
+        } else {
+            format!(
+                ", resuming: {} finished, {to_run} to run",
+                options.resume.len()
+            )
+        }
+    );
+    if plan.scenario.randomise.is_empty() && !args.quiet {
+        eprintln!(
+            "warning: scenario {} randomises nothing: every instance is the same run",
+            plan.scenario.name
+        );
+    }
     let bar = if !args.quiet && std::io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new(instances.end - instances.start);
+        let bar = indicatif::ProgressBar::new(to_run);
         let style = indicatif::ProgressStyle::with_template(
             "{msg} [{bar:30}] {pos}/{len} runs, {per_sec}, ETA {eta}",
         )
@@ -228,20 +304,52 @@ pub(crate) fn cmd_sweep(args: &SweepArgs) -> Result<(), Failure> {
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let options = SweepOptions {
-        threads: args.threads,
+    let write_error: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+    let on_run = |run: &mergesim::sweep::FinishedRun| {
+        bar.inc(1);
+        let Some(writer) = &writer else { return };
+        let line = match mergesim::sweep::jsonl_line(&identity, &run.row, run.wall_time_s) {
+            Ok(line) => line,
+            Err(e) => {
+                record_first(&write_error, e.to_string());
+                return;
+            }
+        };
+        let mut file = match writer.lock() {
+            Ok(file) => file,
+            Err(poisoned) => poisoned.into_inner(),
+        };
+        if let Err(e) = writeln!(file, "{line}").and_then(|()| file.flush()) {
+            record_first(&write_error, e.to_string());
+            // Stop the sweep: rows that cannot be kept must not be computed.
+            interrupt
+                .flag
+                .store(true, std::sync::atomic::Ordering::Relaxed);
+        }
     };
-    let outcome = run_sweep(&plan, &options, &|| bar.inc(1)).map_err(sweep_failure)?;
+    let outcome = run_sweep(&plan, &options, &on_run).map_err(sweep_failure)?;
     bar.finish_and_clear();
+    if let Some(writer) = writer {
+        let file = match writer.into_inner() {
+            Ok(file) => file,
+            Err(poisoned) => poisoned.into_inner(),
+        };
+        file.sync_all().ok();
+    }
+    let write_error = match write_error.into_inner() {
+        Ok(e) => e,
+        Err(poisoned) => poisoned.into_inner(),
+    };
+    if let Some(e) = write_error {
+        return Err(run_failure(anyhow!(
+            "cannot append to --jsonl {}: {e}; the sweep stopped (rows written so far are kept)",
+            jsonl
+                .map(|(p, _)| p.display().to_string())
+                .unwrap_or_default()
+        )));
+    }
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&outcome.summary).map_err(run_failure)?;
-        write_output(path, &text)?;
-    }
-    if let Some(path) = &args.jsonl {
-        let text = outcome
-            .summary
-            .jsonl(&outcome.run_wall_times_s)
-            .map_err(run_failure)?;
         write_output(path, &text)?;
     }
     if !args.quiet {
@@ -256,7 +364,77 @@ pub(crate) fn cmd_sweep(args: &SweepArgs) -> Result<(), Failure> {
             );
         }
     }
-    Ok(())
+    use mergesim::sweep::SweepVerdict;
+    match outcome.verdict() {
+        SweepVerdict::Complete => Ok(()),
+        SweepVerdict::Interrupted { missing } => Err(interrupted(
+            interrupt,
+            &format!(
+                "{} of {} runs finished ({} in this attempt), {missing} missing; {}resume with \
+                 the same command plus --resume{}",
+                outcome.summary.runs,
+                instances.end - instances.start,
+                outcome.new_runs,
+                if args.json.is_some() {
+                    "the --json aggregate covers the finished runs (missing_runs > 0); "
+                } else {
+                    ""
+                },
+                if args.jsonl.is_some() {
+                    ""
+                } else {
+                    " (needs --jsonl: without it the finished rows are only in the --json file)"
+                }
+            ),
+        )),
+        SweepVerdict::RunsFailed { failed, of } => Err(run_failure(anyhow!(
+            "{failed} of {of} runs failed (panicked {}); their errors are listed above and in \
+             the rows",
+            outcome.summary.panicked
+        ))),
+    }
+}
+
+/// Keeps the first error of the JSONL writer.
+fn record_first(slot: &std::sync::Mutex<Option<String>>, error: String) {
+    let mut slot = match slot.lock() {
+        Ok(slot) => slot,
+        Err(poisoned) => poisoned.into_inner(),
+    };
+    slot.get_or_insert(error);
+}
+
+/// Opens the JSONL for appending: created afresh (`complete_len` None), or an existing one
+/// cut to its complete lines (`Some(len)`, a torn last line dropped).
+fn open_jsonl(
+    path: &std::path::Path,
+    complete_len: Option<usize>,
+) -> Result<std::fs::File, Failure> {
+    let context = || format!("cannot open --jsonl {}", path.display());
+    let file = match complete_len {
+        None => std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(path)
+            .with_context(context)
+            .map_err(input)?,
+        Some(len) => {
+            let file = std::fs::OpenOptions::new()
+                .write(true)
+                .open(path)
+                .with_context(context)
+                .map_err(input)?;
+            file.set_len(len as u64)
+                .with_context(context)
+                .map_err(input)?;
+            file
+        }
+    };
+    let mut file = file;
+    file.seek(std::io::SeekFrom::End(0))
+        .with_context(context)
+        .map_err(input)?;
+    Ok(file)
 }
 
 pub(crate) fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> {
@@ -286,11 +464,8 @@ pub(crate) fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> 
     Ok(())
 }
 
-/// Most instances a grid cell may run (the default grid runs 36 cells × planners of them).
-const MAX_GRID_RUNS: u64 = 10_000;
-
-pub(crate) fn cmd_grid(args: &GridArgs) -> Result<(), Failure> {
-    use mergesim::grid::{GridAxes, GridMetric, GridPlan, job_count, run_grid};
+pub(crate) fn cmd_grid(args: &GridArgs, interrupt: &Interrupt) -> Result<(), Failure> {
+    use mergesim::grid::{GridAxes, GridMetric, GridPlan, MAX_GRID_RUNS, job_count, run_grid};
     let scenario = load_scenario(&args.source.scenario, args.source.params)?;
     if !scenario.vehicles.iter().any(|v| v.name == args.vehicle) {
         return Err(input(anyhow!(
@@ -341,6 +516,7 @@ pub(crate) fn cmd_grid(args: &GridArgs) -> Result<(), Failure> {
         runs: args.runs,
         seed: args.seed,
         threads: args.threads,
+        interrupt: Some(interrupt.flag.clone()),
     };
     let bar = if !args.quiet && std::io::stderr().is_terminal() {
         let bar = indicatif::ProgressBar::new(job_count(&plan));
@@ -354,7 +530,12 @@ pub(crate) fn cmd_grid(args: &GridArgs) -> Result<(), Failure> {
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let outcome = run_grid(&plan, &|| bar.inc(1)).map_err(|e| run_failure(anyhow!(e)))?;
+    let outcome = run_grid(&plan, &|| bar.inc(1));
+    if interrupt.raised() {
+        bar.finish_and_clear();
+        return Err(interrupted(interrupt, "grid stopped; nothing written"));
+    }
+    let outcome = outcome.map_err(|e| run_failure(anyhow!(e)))?;
     bar.finish_and_clear();
     let peak = outcome.paired_differences(&args.vehicle, GridMetric::PeakYawRate);
     let zone = outcome.paired_differences(&args.vehicle, GridMetric::MergeZoneRmsYawRate);
@@ -382,5 +563,10 @@ pub(crate) fn cmd_grid(args: &GridArgs) -> Result<(), Failure> {
         }
         outln!("wall time {:.1} s", outcome.wall_time_s);
     }
+    Ok(())
+}
+
+pub(crate) fn cmd_limits() -> Result<(), Failure> {
+    out!("{}", mergesim::limits::markdown());
     Ok(())
 }

@@ -1,7 +1,9 @@
 //! `merge_sim`: run, compare and inspect cooperative merge simulations.
 //!
-//! Exit codes: 0 success, 1 the simulation or an output failed, 2 bad input (arguments,
-//! scenario values, presets) — reported with the offending value, before anything is written.
+//! Exit codes: 0 success; 1 the simulation or an output failed, or some runs of a sweep failed;
+//! 2 bad input (arguments, scenario values, presets, output paths) — reported with the
+//! offending value, before any work and before anything is written; 130 / 143 interrupted by
+//! SIGINT / SIGTERM (a sweep first writes what finished).
 //!
 //! This binary only parses the command line ([`args`]), calls the library
 //! (`mergesim::experiment::run_instance`, `mergesim::sweep`, `mergesim::grid`, …) and prints
@@ -9,6 +11,7 @@
 
 mod args;
 mod commands;
+mod signals;
 
 use std::process::ExitCode;
 
@@ -48,15 +51,17 @@ pub(crate) use {out, outln};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let interrupt = signals::Interrupt::install();
     let result = match cli.command {
-        None => commands::cmd_run(&cli.run),
-        Some(Command::Run(args)) => commands::cmd_run(&args),
-        Some(Command::Compare(args)) => commands::cmd_compare(&args),
+        None => commands::cmd_run(&cli.run, &interrupt),
+        Some(Command::Run(args)) => commands::cmd_run(&args, &interrupt),
+        Some(Command::Compare(args)) => commands::cmd_compare(&args, &interrupt),
         Some(Command::Maneuver(args)) => commands::cmd_maneuver(&args),
         Some(Command::Scenario(cmd)) => commands::cmd_scenario(&cmd),
-        Some(Command::Sweep(args)) => commands::cmd_sweep(&args),
+        Some(Command::Sweep(args)) => commands::cmd_sweep(&args, &interrupt),
         Some(Command::MergeResults(args)) => commands::cmd_merge_results(&args),
-        Some(Command::Grid(args)) => commands::cmd_grid(&args),
+        Some(Command::Grid(args)) => commands::cmd_grid(&args, &interrupt),
+        Some(Command::Limits) => commands::cmd_limits(),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -68,13 +73,27 @@ fn main() -> ExitCode {
             eprintln!("error: {e:#}");
             ExitCode::from(1)
         }
+        Err(Failure::Interrupted { code, message }) => {
+            eprintln!("{message}");
+            ExitCode::from(code)
+        }
     }
 }
 
-/// An error with its exit code: 2 for bad input, 1 for failures while running.
+/// An error with its exit code: 2 for bad input, 1 for failures while running, 128 + the
+/// signal's number when interrupted.
 pub(crate) enum Failure {
     Input(anyhow::Error),
     Run(anyhow::Error),
+    Interrupted { code: u8, message: String },
+}
+
+/// The failure of a command stopped by `interrupt` (`what` is done).
+pub(crate) fn interrupted(interrupt: &signals::Interrupt, what: &str) -> Failure {
+    Failure::Interrupted {
+        code: interrupt.exit_code(),
+        message: format!("interrupted by {}: {what}", interrupt.name()),
+    }
 }
 
 pub(crate) fn input<E: Into<anyhow::Error>>(e: E) -> Failure {
@@ -123,6 +142,7 @@ pub(crate) fn simulate(
     rrd: Option<&std::path::Path>,
     keep_time_series: bool,
     show_progress: bool,
+    interrupt: &signals::Interrupt,
 ) -> Result<Finished, Failure> {
     let planner = planner.map(|k| k.name().to_string());
     let label = planner_label(scenario, planner.as_deref());
@@ -136,6 +156,7 @@ pub(crate) fn simulate(
         planner,
         seed,
         keep_time_series,
+        interrupt: Some(interrupt.flag.clone()),
     };
     let progress = progress_printer(show_progress, format!("{} {label}", scenario.name));
     run_instance(
@@ -147,6 +168,12 @@ pub(crate) fn simulate(
     )
     .map_err(|e| match e {
         RunError::Setup(e) => input(e),
+        RunError::Run(sim::SimError::Interrupted { t_s }) => interrupted(
+            interrupt,
+            &format!(
+                "run stopped at t = {t_s:.2} s; nothing written, the partial recording deleted"
+            ),
+        ),
         RunError::Run(e) => run_failure(e),
     })
 }

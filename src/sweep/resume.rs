@@ -1,0 +1,78 @@
+//! Reading the JSONL of an interrupted sweep back (`merge_sim sweep … --resume`).
+
+use super::rows::JsonlRecord;
+use super::{FinishedRun, SweepError, SweepIdentity};
+
+/// The finished runs of a JSONL file and what was wrong with its end.
+#[derive(Clone, Debug, Default)]
+pub struct ResumedRows {
+    /// The runs, in file order.
+    pub runs: Vec<FinishedRun>,
+    /// Bytes of complete lines: a last line without its newline (a write cut short by a hard
+    /// kill) lies beyond this and is dropped, its run run again.
+    pub complete_len: usize,
+    /// Whether such a torn last line was found.
+    pub torn_last_line: bool,
+}
+
+/// Reads the runs of the JSONL `text` (from `origin`, named in errors) written by a sweep
+/// with identity `identity`. Every complete line must be a row of that sweep: a line of another
+/// sweep (scenario, fingerprint, parameter set, planner, seed or run count differ) or one that
+/// does not parse is an error naming its line and field.
+pub fn read_jsonl(
+    text: &str,
+    origin: &str,
+    identity: &SweepIdentity,
+) -> Result<ResumedRows, SweepError> {
+    let complete_len = text.rfind('\n').map_or(0, |i| i + 1);
+    let mut runs = Vec::new();
+    for (index, line) in text[..complete_len].lines().enumerate() {
+        let number = index + 1;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let record: JsonlRecord = serde_json::from_str(line).map_err(|e| {
+            SweepError::Invalid(format!(
+                "{origin}, line {number}: not a row of `merge_sim sweep --jsonl`: {e}"
+            ))
+        })?;
+        let fields = [
+            ("scenario", &identity.scenario, &record.scenario),
+            (
+                "scenario_fingerprint",
+                &identity.scenario_fingerprint,
+                &record.scenario_fingerprint,
+            ),
+            ("params", &identity.params, &record.params),
+            ("planner", &identity.planner, &record.planner),
+            (
+                "sweep_seed",
+                &identity.seed.to_string(),
+                &record.sweep_seed.to_string(),
+            ),
+            (
+                "total_runs",
+                &identity.total_runs.to_string(),
+                &record.total_runs.to_string(),
+            ),
+        ];
+        for (field, expected, found) in fields {
+            if expected != found {
+                return Err(SweepError::Invalid(format!(
+                    "{origin}, line {number}: {field} = {found}, but this sweep has {field} = \
+                     {expected}: the file holds rows of another sweep (resume with the same \
+                     scenario, parameters, planner, --runs and --seed)"
+                )));
+            }
+        }
+        runs.push(FinishedRun {
+            row: record.row,
+            wall_time_s: record.wall_time_s,
+        });
+    }
+    Ok(ResumedRows {
+        runs,
+        complete_len,
+        torn_last_line: complete_len < text.len(),
+    })
+}
