@@ -70,6 +70,7 @@ impl Behaviour for TimeGapCruise {
             path,
             broadcast: Some(broadcast),
             fallback: None,
+            degraded_mode: None,
         })
     }
 }

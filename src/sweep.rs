@@ -389,6 +389,7 @@ mod tests {
             min_speed_mps: 10.0 + x,
             yaw_rate_sign_changes: seed % 3,
             fallbacks: seed % 2,
+            degraded_plans: 0,
             plans: 10,
         })
     }

@@ -468,7 +468,7 @@ fn the_readme_limits_section_is_the_output_of_merge_sim_limits() {
     assert_eq!(
         readme[start..stop].trim(),
         printed.trim(),
-        "README \"Limits\" is stale: paste the output of `merge_sim limits`"
+        "README \"Limits\" is stale: run scripts/update_readme_limits.py"
     );
     assert!(printed.contains("`[sim.tracker]` `lookahead_min_m`"));
 }

@@ -27,6 +27,10 @@ impl Behaviour for PfPlanner {
             fallback: plan.fallback.as_ref().map(|reason| format!("{reason:?}")),
             path: plan.path,
             broadcast: Some(plan.shared),
+            degraded_mode: self
+                .last_stats()
+                .v2v_degraded
+                .then(|| "v2v-lost".to_string()),
         })
     }
 

@@ -12,6 +12,7 @@ pub mod cubic_fit;
 pub mod error;
 pub mod fallback;
 pub mod field_params;
+pub mod following;
 pub mod local_path;
 pub mod min_distance;
 pub mod obstacle_field;
@@ -29,6 +30,7 @@ pub mod speed_profile;
 pub mod types;
 
 pub use error::PlannerError;
+pub use following::V2vLossFallback;
 pub use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
 pub use parameter_set::ParameterSet;
 pub use params::{PlannerParams, SlpReading};

@@ -65,6 +65,12 @@ fn fresh_shared_paths<'a>(
     newest
 }
 
+/// Whether any vehicle other than the ego has a fresh SLP in `req` (else PF-ISO has lost V2V,
+/// or nobody around is connected).
+pub fn has_fresh_shared_path(params: &PlannerParams, req: &PlanRequest<'_>) -> bool {
+    !fresh_shared_paths(params, req).is_empty()
+}
+
 /// The others, by id: received SLPs if `use_shared_paths` (PF-ISO), then a prediction with
 /// `model` for every perceived neighbour without one.
 pub fn gather_others(

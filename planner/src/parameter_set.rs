@@ -17,6 +17,7 @@
 //! | `interaction_time_gap_s` | 0 | 2 s | as the path field's |
 //! | `interaction_rear_only`, `roles_from_order_now` | false, false | true, true | who keeps the gap (the follower), decided once from the order now for predicted vehicles |
 //! | `prediction` | `constant-velocity` | `lane-following` | a car 0.02 rad off the road axis is predicted a lane off after 160 m |
+//! | `v2v_loss_fallback` | `interact-with-predictions` | `risk-aware-following` | without any shared path the interaction term on predictions lets two cars side by side each expect the other to yield (the paper says nothing about losing V2V) |
 //!
 //! Each row's cost is measured in `docs/reproduction.md`.
 
@@ -25,6 +26,7 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 
 use crate::error::PlannerError;
+use crate::following::V2vLossFallback;
 use crate::obstacle_field::{HeadingForm, MinDistanceLength};
 use crate::params::{PlannerParams, SlpReading};
 use crate::prediction::PredictionModel;
@@ -70,6 +72,7 @@ impl ParameterSet {
                 interaction_rear_only: false,
                 roles_from_order_now: false,
                 prediction: PredictionModel::ConstantVelocity,
+                v2v_loss_fallback: V2vLossFallback::InteractWithPredictions,
                 // U_SLP is "calculated like Eq. 4": the same ε, d_lat and f as the path field.
                 interaction_epsilon: PlannerParams::default().obstacle_epsilon,
                 interaction_lateral_safety_m: PlannerParams::default().obstacle_lateral_safety_m,

@@ -11,6 +11,7 @@ use mergesim_types::Bound;
 use mergesim_types::bounds;
 
 use crate::error::PlannerError;
+use crate::following::V2vLossFallback;
 use crate::obstacle_field::{HeadingForm, MinDistanceLength, ObstacleFieldParams};
 use crate::prediction::PredictionModel;
 
@@ -217,6 +218,22 @@ pub struct PlannerParams {
     /// the path-field parameters), predicted without V2V, along the vehicle's own path.
     pub risk_weight: f64,
 
+    // ---------------------------------------------------------------- V2V loss (PF-ISO)
+    /// What PF-ISO does in a cycle without any fresh shared path from the vehicles around it
+    /// (`following` module): `risk-aware-following` (PF-SP's speeds with Gipps' safe-following
+    /// cap; ours) or `interact-with-predictions` (the interaction term on predictions).
+    pub v2v_loss_fallback: V2vLossFallback,
+    /// τ of the safe-following cap: reaction time before braking (s). One second: twice the
+    /// planning loop's worst delay (a planning period of 0.1 s plus one slot of 0.4 s).
+    pub following_reaction_s: f64,
+    /// s₀ of the safe-following cap: bumper gap left when both have stopped (m); 2 m, the
+    /// standstill gap of the Intelligent Driver Model's usual calibration.
+    pub following_standstill_gap_m: f64,
+    /// A vehicle ahead is in the planning vehicle's corridor when its lateral distance from the
+    /// planned path is below the half-widths plus this margin (m); 0.5 m, the near-miss gap
+    /// of the safety monitor.
+    pub following_lateral_margin_m: f64,
+
     // ---------------------------------------------------------------- faults
     /// Comfortable deceleration of the fallback plan (m/s², positive).
     pub fallback_decel_mps2: f64,
@@ -300,6 +317,10 @@ impl Default for PlannerParams {
             // Twice the smallest weight with which the risk term keeps a PF-SP follower behind
             // a slower leader on a single lane (19.5; docs/parameters.md).
             risk_weight: 39.0,
+            v2v_loss_fallback: V2vLossFallback::RiskAwareFollowing,
+            following_reaction_s: 1.0,
+            following_standstill_gap_m: 2.0,
+            following_lateral_margin_m: 0.5,
             fallback_decel_mps2: 2.0,
         }
     }
@@ -365,6 +386,9 @@ pub const PLANNER_BOUNDS: &[Bound] = &[
     Bound::closed("solver_tolerance", 1e-12, 1e-2, ""),
     Bound::closed("max_shared_path_age_s", 0.0, 60.0, "s"),
     Bound::closed("risk_weight", 0.0, 1e4, ""),
+    Bound::closed("following_reaction_s", 0.0, 5.0, "s"),
+    Bound::closed("following_standstill_gap_m", 0.0, 20.0, "m"),
+    Bound::closed("following_lateral_margin_m", 0.0, 5.0, "m"),
     Bound::above("fallback_decel_mps2", 0.0, 20.0, "m/s²"),
 ];
 
@@ -429,6 +453,15 @@ impl PlannerParams {
             ("solver_tolerance", self.solver_tolerance),
             ("max_shared_path_age_s", self.max_shared_path_age_s),
             ("risk_weight", self.risk_weight),
+            ("following_reaction_s", self.following_reaction_s),
+            (
+                "following_standstill_gap_m",
+                self.following_standstill_gap_m,
+            ),
+            (
+                "following_lateral_margin_m",
+                self.following_lateral_margin_m,
+            ),
             ("fallback_decel_mps2", self.fallback_decel_mps2),
         ]
     }

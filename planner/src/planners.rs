@@ -23,8 +23,11 @@ use serde::{Deserialize, Serialize};
 use crate::cubic_fit::{FitMethod, fit_path_cubic};
 use crate::error::PlannerError;
 use crate::fallback::{FallbackInput, fallback_plan};
+use crate::following::{V2vLossFallback, following_cap_mps};
 use crate::local_path::local_path_adaptive;
-use crate::others::{RoleRules, arc_length_term, fixed_waypoint_term, gather_others};
+use crate::others::{
+    RoleRules, arc_length_term, fixed_waypoint_term, gather_others, has_fresh_shared_path,
+};
 use crate::params::{PlannerParams, SlpReading};
 use crate::polyline::Polyline;
 use crate::potential_field::{GridSpec, PotentialField};
@@ -133,6 +136,9 @@ pub struct PlanStats {
     pub interacting_vehicles: usize,
     /// Whether the plan is a fallback.
     pub fallback: bool,
+    /// Whether PF-ISO planned without any fresh shared path around it (V2V lost), with
+    /// `v2v_loss_fallback = risk-aware-following` (`following` module).
+    pub v2v_degraded: bool,
 }
 
 /// A potential-field planner of one vehicle. Holds the last good plan (for the fallback and
@@ -145,6 +151,9 @@ pub struct PfPlanner {
     last_good: Option<Plan>,
     optimiser: SpeedOptimiser,
     stats: PlanStats,
+    /// Time of the first planning cycle (s): V2V counts as lost only once a shared path could
+    /// have arrived (`max_shared_path_age_s` after it).
+    first_plan_s: Option<f64>,
 }
 
 fn non_finite(what: &str) -> PlannerError {
@@ -253,6 +262,7 @@ impl PfPlanner {
             last_good: None,
             optimiser: SpeedOptimiser::new(),
             stats: PlanStats::default(),
+            first_plan_s: None,
         })
     }
 
@@ -321,6 +331,7 @@ impl PfPlanner {
     pub fn plan(&mut self, req: &PlanRequest<'_>) -> Result<Plan, PlannerError> {
         validate_request(req)?;
         self.stats = PlanStats::default();
+        self.first_plan_s.get_or_insert(req.time_s);
         match self.plan_cycle(req) {
             Ok(plan) => {
                 self.last_good = Some(plan.clone());
@@ -459,8 +470,23 @@ impl PfPlanner {
         let line = Polyline::with_start([req.ego.x_m, req.ego.y_m], points.iter().copied());
         let segment_lengths_m = line.segment_lengths_m();
 
+        // V2V lost (`following` module): a PF-ISO cycle without any fresh shared path around
+        // plans its speeds as PF-SP, capped at the safe following speed.
+        let heard_for_s = req.time_s - self.first_plan_s.unwrap_or(req.time_s);
+        let degraded = self.kind == PlannerKind::PfIso
+            && params.v2v_loss_fallback == V2vLossFallback::RiskAwareFollowing
+            && heard_for_s > params.max_shared_path_age_s
+            && req.neighbours.iter().any(|n| n.id != req.ego_id)
+            && !has_fresh_shared_path(params, req);
+        self.stats.v2v_degraded = degraded;
+        let speed_kind = if degraded {
+            PlannerKind::PfSp
+        } else {
+            self.kind
+        };
+
         // Speeds (Eq. 10, or PF-SP's risk-aware problem).
-        let speeds_mps = match self.kind {
+        let speeds_mps = match speed_kind {
             PlannerKind::PfCs => vec![
                 req.target_speed_mps
                     .clamp(params.min_speed_mps, params.speed_limit_mps);
@@ -485,6 +511,23 @@ impl PfPlanner {
                     for (i, v) in max_speeds_mps.iter_mut().enumerate() {
                         let from_now = req.ego.speed_mps - decel_mps * (i + 1) as f64;
                         *v = v.min(req.target_speed_mps.max(from_now));
+                    }
+                }
+                if degraded
+                    && let Some(cap_mps) = following_cap_mps(
+                        params,
+                        req.ego_id,
+                        &req.ego,
+                        &req.ego_shape,
+                        req.neighbours,
+                        &points,
+                    )
+                {
+                    // Reached no faster than at a_max from the current speed (feasible).
+                    let decel_mps = params.max_accel_mps2 * params.step_time_s;
+                    for (i, v) in max_speeds_mps.iter_mut().enumerate() {
+                        let from_now = req.ego.speed_mps - decel_mps * (i + 1) as f64;
+                        *v = v.min(cap_mps.max(from_now).max(params.min_speed_mps));
                     }
                 }
                 let (term, weight, count) = self.speed_term(kind, req, &line, &waypoints);

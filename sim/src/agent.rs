@@ -28,6 +28,8 @@ pub struct Agent {
     pub path: Vec<PathPoint>,
     /// Whether a vehicle that started in the ending lane has crossed the divider yet.
     pub merged: bool,
+    /// The degraded mode of its last decision (events on changes).
+    pub degraded_mode: Option<String>,
 }
 
 /// The behaviour of `spec`: its planner from the registry (or `planner_override`, which
@@ -86,6 +88,7 @@ impl Agent {
             tracker,
             path: Vec::new(),
             merged: spec.lane == Lane::Upper,
+            degraded_mode: None,
         })
     }
 }

@@ -80,6 +80,9 @@ pub struct PlannerStats {
     pub plans: u64,
     /// Cycles that returned a fallback plan.
     pub fallbacks: u64,
+    /// Cycles decided in a degraded mode (PF-ISO without any shared path around: V2V lost).
+    #[serde(default)]
+    pub degraded_plans: u64,
     /// Median wall time of one cycle (µs). Wall-clock: not part of the determinism contract.
     pub p50_plan_us: f64,
     /// 99th percentile wall time of one cycle (µs).

@@ -1,7 +1,13 @@
 //! The V2V bus: shared local paths (SLP) broadcast by connected vehicles, delivered after a
 //! latency, possibly dropped, and ignored once stale (step 1 of the tick).
 //!
-//! The paper assumes ideal communication (no latency, no loss): that is the default.
+//! The paper assumes ideal communication (no latency, no loss): that is the default. Faults:
+//! a fixed latency, random extra delay (`jitter_s`: messages of one sender can arrive out of
+//! order), losses (`drop_probability`) and duplicated deliveries (`duplicate_probability`). A
+//! receiver keeps the newest path of each sender by its time stamp, so a late or repeated
+//! message never replaces a newer one. Drops come from one random stream and jitter and
+//! duplicates from another, both seeded by the run's seed, so enabling jitter or duplicates
+//! does not change which messages are dropped.
 
 use std::collections::BTreeMap;
 
@@ -25,6 +31,14 @@ pub struct V2vParams {
     pub broadcast_period_s: f64,
     /// A received path older than this (by its time stamp) is ignored (s).
     pub stale_after_s: f64,
+    /// Extra delay of each delivery, uniform in [0, jitter_s] (s): reorders messages whose
+    /// send times are closer than the jitter.
+    #[serde(default)]
+    pub jitter_s: f64,
+    /// Probability that a delivered message is delivered a second time, after another
+    /// independent delay.
+    #[serde(default)]
+    pub duplicate_probability: f64,
 }
 
 impl Default for V2vParams {
@@ -34,6 +48,8 @@ impl Default for V2vParams {
             drop_probability: 0.0,
             broadcast_period_s: 0.0,
             stale_after_s: 0.5,
+            jitter_s: 0.0,
+            duplicate_probability: 0.0,
         }
     }
 }
@@ -44,6 +60,8 @@ pub const V2V_BOUNDS: &[Bound] = &[
     Bound::closed("drop_probability", 0.0, 1.0, ""),
     Bound::closed("broadcast_period_s", 0.0, 10.0, "s"),
     Bound::above("stale_after_s", 0.0, 60.0, "s"),
+    Bound::closed("jitter_s", 0.0, 10.0, "s"),
+    Bound::closed("duplicate_probability", 0.0, 1.0, ""),
 ];
 
 impl V2vParams {
@@ -57,6 +75,8 @@ impl V2vParams {
                 ("drop_probability", self.drop_probability),
                 ("broadcast_period_s", self.broadcast_period_s),
                 ("stale_after_s", self.stale_after_s),
+                ("jitter_s", self.jitter_s),
+                ("duplicate_probability", self.duplicate_probability),
             ],
         )?;
         Ok(())
@@ -80,6 +100,9 @@ pub struct V2vStats {
     pub delivered: u64,
     /// Per-receiver drops.
     pub dropped: u64,
+    /// Extra deliveries of duplicated messages.
+    #[serde(default)]
+    pub duplicated: u64,
 }
 
 /// The bus. Everything is kept in ordered maps and vectors so delivery order is deterministic.
@@ -87,6 +110,8 @@ pub struct V2vStats {
 pub struct V2vBus {
     params: V2vParams,
     rng: SplitMix64,
+    /// Jitter and duplicates (a stream of its own: see the module doc).
+    fault_rng: SplitMix64,
     in_flight: Vec<InFlight>,
     /// receiver → sender → newest delivered path.
     inbox: BTreeMap<VehicleId, BTreeMap<VehicleId, SharedLocalPath>>,
@@ -101,6 +126,7 @@ impl V2vBus {
         Ok(Self {
             params,
             rng: SplitMix64::new(seed),
+            fault_rng: SplitMix64::new(SplitMix64::derive(seed, 1)),
             in_flight: Vec::new(),
             inbox: BTreeMap::new(),
             last_broadcast_s: BTreeMap::new(),
@@ -150,15 +176,28 @@ impl V2vBus {
                 self.stats.dropped += 1;
                 continue;
             }
-            self.in_flight.push(InFlight {
-                deliver_at_s: t_s + self.params.latency_s,
-                receiver,
-                message: message.clone(),
-            });
+            let copies = if self.params.duplicate_probability > 0.0
+                && self.fault_rng.next_f64() < self.params.duplicate_probability
+            {
+                self.stats.duplicated += 1;
+                2
+            } else {
+                1
+            };
+            for _ in 0..copies {
+                let jitter_s = if self.params.jitter_s > 0.0 {
+                    self.params.jitter_s * self.fault_rng.next_f64()
+                } else {
+                    0.0
+                };
+                self.in_flight.push(InFlight {
+                    deliver_at_s: t_s + self.params.latency_s + jitter_s,
+                    receiver,
+                    message: message.clone(),
+                });
+            }
         }
-        if self.params.latency_s == 0.0 {
-            self.deliver(t_s);
-        }
+        self.deliver(t_s);
         true
     }
 
@@ -283,5 +322,70 @@ mod tests {
             err.contains("v2v.drop_probability") && err.contains("1.5"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn late_and_repeated_messages_never_replace_newer_ones() {
+        let params = V2vParams {
+            latency_s: 0.05,
+            jitter_s: 0.3,
+            duplicate_probability: 0.5,
+            stale_after_s: 10.0,
+            ..V2vParams::default()
+        };
+        let mut bus = V2vBus::new(params, 9).unwrap();
+        let mut reordered = 0;
+        let mut newest_seen = f64::NEG_INFINITY;
+        for k in 0..400 {
+            let t_s = 0.1 * k as f64;
+            bus.broadcast(t_s, &msg(0, t_s), &[1]);
+            bus.deliver(t_s);
+            let held = bus.fresh_paths(1, t_s);
+            if let Some(path) = held.first() {
+                // The held stamp never goes back, though deliveries arrive out of order.
+                assert!(
+                    path.stamp_s >= newest_seen,
+                    "{} < {newest_seen}",
+                    path.stamp_s
+                );
+                if path.stamp_s < t_s - 0.05 - 0.1 {
+                    reordered += 1;
+                }
+                newest_seen = path.stamp_s;
+            }
+            assert!(held.len() <= 1, "one path per sender");
+        }
+        let stats = bus.stats();
+        assert!(
+            stats.duplicated > 150 && stats.duplicated < 250,
+            "{stats:?}"
+        );
+        assert_eq!(stats.delivered, 400 + stats.duplicated - pending(&bus));
+        assert!(
+            reordered > 0,
+            "the jitter must delay some messages past a later one"
+        );
+    }
+
+    fn pending(bus: &V2vBus) -> u64 {
+        bus.in_flight.len() as u64
+    }
+
+    #[test]
+    fn jitter_and_duplicates_leave_the_drops_unchanged() {
+        let run = |jitter_s, duplicate_probability| {
+            let params = V2vParams {
+                drop_probability: 0.3,
+                jitter_s,
+                duplicate_probability,
+                ..V2vParams::default()
+            };
+            let mut bus = V2vBus::new(params, 4).unwrap();
+            for k in 0..1000 {
+                bus.broadcast(k as f64, &msg(0, k as f64), &[1, 2]);
+            }
+            bus.stats().dropped
+        };
+        assert_eq!(run(0.0, 0.0), run(0.5, 0.5));
     }
 }

@@ -53,6 +53,7 @@ pub struct World {
     events: Vec<String>,
     plan_times_us: Vec<f64>,
     fallbacks: u64,
+    degraded_plans: u64,
     step_index: u64,
     steps_per_plan: u64,
     steps_per_log: u64,
@@ -136,6 +137,7 @@ impl World {
             events: Vec::new(),
             plan_times_us: Vec::new(),
             fallbacks: 0,
+            degraded_plans: 0,
             step_index: 0,
             reported_collisions: 0,
             reported_edge_contacts: 0,
@@ -411,6 +413,22 @@ impl World {
             let connected = agent.spec.connected;
             if is_planner {
                 self.plan_times_us.push(elapsed_us);
+                if decision.degraded_mode.is_some() {
+                    self.degraded_plans += 1;
+                }
+                if decision.degraded_mode != self.agents[index].degraded_mode {
+                    let text = match (&decision.degraded_mode, &self.agents[index].degraded_mode) {
+                        (Some(mode), _) => {
+                            format!("t = {t_s:.2} s: {name} plans in degraded mode {mode}")
+                        }
+                        (None, Some(mode)) => {
+                            format!("t = {t_s:.2} s: {name} left degraded mode {mode}")
+                        }
+                        (None, None) => String::new(),
+                    };
+                    self.agents[index].degraded_mode = decision.degraded_mode.clone();
+                    self.event(text, EventLevel::Warn)?;
+                }
                 if let Some(reason) = &decision.fallback {
                     self.fallbacks += 1;
                     self.event(
@@ -545,6 +563,7 @@ impl World {
         let planner_stats = PlannerStats {
             plans: times.len() as u64,
             fallbacks: self.fallbacks,
+            degraded_plans: self.degraded_plans,
             p50_plan_us: percentile(&times, 0.50),
             p99_plan_us: percentile(&times, 0.99),
         };

@@ -42,6 +42,9 @@ pub struct RunMetrics {
     pub yaw_rate_sign_changes: u64,
     /// Planner cycles that fell back.
     pub fallbacks: u64,
+    /// Planner cycles decided in a degraded mode (PF-ISO without any shared path around).
+    #[serde(default)]
+    pub degraded_plans: u64,
     /// Planner cycles.
     pub plans: u64,
 }
@@ -72,6 +75,7 @@ impl RunMetrics {
                 .map(|v| u64::from(v.yaw_rate_sign_changes))
                 .sum(),
             fallbacks: summary.planner_stats.fallbacks,
+            degraded_plans: summary.planner_stats.degraded_plans,
             plans: summary.planner_stats.plans,
         }
     }

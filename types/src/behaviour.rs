@@ -66,6 +66,10 @@ pub struct Decision {
     pub broadcast: Option<SharedLocalPath>,
     /// Why this decision is a fallback (logged and counted), if it is one.
     pub fallback: Option<String>,
+    /// The degraded mode this decision was made in, if any (e.g. `v2v-lost`: no shared path
+    /// heard from anybody around); the simulator counts such decisions and logs when a
+    /// vehicle enters and leaves a mode.
+    pub degraded_mode: Option<String>,
 }
 
 impl Decision {
@@ -75,6 +79,7 @@ impl Decision {
             path,
             broadcast: None,
             fallback: None,
+            degraded_mode: None,
         }
     }
 }

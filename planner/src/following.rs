@@ -1,0 +1,176 @@
+//! PF-ISO's behaviour when V2V is lost: risk-aware speeds with a safe-following cap.
+//!
+//! PF-ISO's interaction term is built for *received* shared paths: declared intents with
+//! per-slot roles. When a PF-ISO vehicle has no fresh shared path from anybody around it (its
+//! messages are lost, or nobody near is connected) once a shared path could have arrived
+//! (`max_shared_path_age_s` after its first cycle), it has no intents to negotiate with, and
+//! running the interaction term on predictions lets two vehicles side by side each expect the
+//! other to give way (`docs/robustness.md` measures the collisions). With
+//! [`V2vLossFallback::RiskAwareFollowing`] (the `mergesim` default) such a cycle instead
+//!
+//! 1. plans its speeds as PF-SP does (the risk of the others' path fields at their predicted
+//!    positions along its own path; the risk may only slow it down), and
+//! 2. caps every speed at the *safe following speed* of Gipps (1981) behind the nearest vehicle
+//!    ahead in its path corridor:
+//!
+//!    v_safe = −b τ + √(b² τ² + v_l² + 2 b (g − s₀)),
+//!
+//!    with g the bumper gap along the road, v_l the leader's speed, b = `max_accel_mps2` (the
+//!    deceleration the speed optimiser itself may command; the leader is assumed to brake no
+//!    harder), τ = `following_reaction_s` and s₀ = `following_standstill_gap_m`. A vehicle
+//!    following at v_safe stops behind a leader that brakes at b, after reacting for τ. The
+//!    cap is reached no faster than at b from the current speed (so the speed problem stays
+//!    feasible).
+//!
+//! A vehicle is *in the corridor* when its centre is ahead of the planning vehicle's and its
+//! lateral distance from the planned path at its longitudinal position is below the half-widths
+//! plus `following_lateral_margin_m`: the car it would hit by driving on, including one it is
+//! squeezing past in a single lane.
+
+use serde::{Deserialize, Serialize};
+
+use crate::params::PlannerParams;
+use crate::types::{Neighbour, VehicleId, VehicleShape, VehicleState};
+
+/// What a PF-ISO vehicle does in a cycle without any fresh shared path around it (module doc).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum V2vLossFallback {
+    /// Keep the interaction term, on predictions of the others (the paper's reading: it does not
+    /// say what happens without V2V).
+    InteractWithPredictions,
+    /// PF-SP's risk-aware speeds with the safe-following cap (our default).
+    #[default]
+    RiskAwareFollowing,
+}
+
+/// Gipps' safe speed behind a leader at bumper gap `gap_m` driving at `leader_speed_mps`
+/// (module doc); 0 when even a standing start is too close.
+pub fn safe_following_speed_mps(params: &PlannerParams, gap_m: f64, leader_speed_mps: f64) -> f64 {
+    let b = params.max_accel_mps2;
+    let tau = params.following_reaction_s;
+    let room_m = gap_m - params.following_standstill_gap_m;
+    let radicand = b * b * tau * tau + leader_speed_mps * leader_speed_mps + 2.0 * b * room_m;
+    if radicand <= 0.0 {
+        return 0.0;
+    }
+    (-b * tau + radicand.sqrt()).max(0.0)
+}
+
+/// Lateral position of the polyline `path` (world points, increasing x assumed piecewise) at
+/// longitudinal position `x_m`: interpolated between the points around it, the end point's
+/// beyond the end, the first point's before the start.
+fn path_y_at(path: &[[f64; 2]], x_m: f64) -> Option<f64> {
+    let first = path.first()?;
+    if x_m <= first[0] {
+        return Some(first[1]);
+    }
+    for pair in path.windows(2) {
+        let ([x0, y0], [x1, y1]) = (pair[0], pair[1]);
+        if x_m <= x1 {
+            let span = x1 - x0;
+            let f = if span > 1e-9 { (x_m - x0) / span } else { 1.0 };
+            return Some(y0 + f * (y1 - y0));
+        }
+    }
+    path.last().map(|p| p[1])
+}
+
+/// The safe-following cap (m/s) of a vehicle at `ego` (shape `ego_shape`) planning along
+/// `path` (world points from its position on), behind the nearest neighbour in its corridor;
+/// `None` when no neighbour is in it.
+pub fn following_cap_mps(
+    params: &PlannerParams,
+    ego_id: VehicleId,
+    ego: &VehicleState,
+    ego_shape: &VehicleShape,
+    neighbours: &[Neighbour],
+    path: &[[f64; 2]],
+) -> Option<f64> {
+    neighbours
+        .iter()
+        .filter(|n| n.id != ego_id && n.state.x_m > ego.x_m)
+        .filter(|n| {
+            let half_widths_m = 0.5 * (ego_shape.width_m + n.shape.width_m);
+            path_y_at(path, n.state.x_m).is_some_and(|y| {
+                (y - n.state.y_m).abs() < half_widths_m + params.following_lateral_margin_m
+            })
+        })
+        .map(|n| {
+            let gap_m = n.state.x_m - ego.x_m - 0.5 * (ego_shape.length_m + n.shape.length_m);
+            safe_following_speed_mps(params, gap_m, n.state.speed_mps)
+        })
+        .reduce(f64::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn neighbour(id: VehicleId, x_m: f64, y_m: f64, speed_mps: f64) -> Neighbour {
+        Neighbour {
+            id,
+            state: VehicleState {
+                x_m,
+                y_m,
+                yaw_rad: 0.0,
+                speed_mps,
+            },
+            shape: VehicleShape::default(),
+        }
+    }
+
+    #[test]
+    fn gipps_speed_stops_behind_a_braking_leader() {
+        let params = PlannerParams::default();
+        let b = params.max_accel_mps2;
+        let tau = params.following_reaction_s;
+        for (gap_m, v_l) in [(30.0, 15.0), (10.0, 14.0), (60.0, 0.0), (3.0, 20.0)] {
+            let v = safe_following_speed_mps(&params, gap_m, v_l);
+            // Travelled while reacting and braking at b vs the leader's braking distance.
+            let follower_m = v * tau + v * v / (2.0 * b);
+            let leader_m = v_l * v_l / (2.0 * b);
+            let left_m = gap_m + leader_m - follower_m;
+            assert!(
+                (left_m - params.following_standstill_gap_m).abs() < 1e-9,
+                "gap {gap_m}, leader {v_l}: v {v}, leaves {left_m} m"
+            );
+        }
+        // Closer than the standstill gap behind a standing car: stop.
+        assert_eq!(safe_following_speed_mps(&params, 1.0, 0.0), 0.0);
+    }
+
+    #[test]
+    fn only_vehicles_ahead_in_the_path_corridor_cap_the_speed() {
+        let params = PlannerParams::default();
+        let ego = VehicleState {
+            x_m: 0.0,
+            y_m: 1.75,
+            yaw_rad: 0.0,
+            speed_mps: 20.0,
+        };
+        let shape = VehicleShape::default();
+        let straight: Vec<[f64; 2]> = (1..=20).map(|i| [8.0 * i as f64, 1.75]).collect();
+        let into_upper: Vec<[f64; 2]> = (1..=20)
+            .map(|i| [8.0 * i as f64, 1.75 + (0.4 * i as f64).min(3.5)])
+            .collect();
+        let beside = neighbour(1, 30.0, 5.25, 15.0);
+        let behind = neighbour(2, -20.0, 1.75, 25.0);
+        let ahead = neighbour(3, 40.0, 1.75, 10.0);
+        let cap = |path: &[[f64; 2]], ns: &[Neighbour]| {
+            following_cap_mps(&params, 0, &ego, &shape, ns, path)
+        };
+        assert_eq!(cap(&straight, &[beside, behind]), None);
+        let gap_m = 40.0 - shape.length_m;
+        assert_eq!(
+            cap(&straight, &[beside, behind, ahead]),
+            Some(safe_following_speed_mps(&params, gap_m, 10.0))
+        );
+        // A path into the other lane puts the car there in the corridor.
+        let gap_m = 30.0 - shape.length_m;
+        assert_eq!(
+            cap(&into_upper, &[beside]),
+            Some(safe_following_speed_mps(&params, gap_m, 15.0))
+        );
+    }
+}
