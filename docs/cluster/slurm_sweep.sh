@@ -12,6 +12,11 @@
 # write; `cat shard_*.jsonl` (in shard order) gives its per-run rows. Any row replays alone:
 #   merge_sim run --scenario urgent_merge --planner pf-iso --seed <row's seed>
 #
+# --resume: a task that is requeued (`scontrol requeue`) or preempted continues from the rows
+# its JSONL already holds instead of starting over (on a first run there is nothing to resume).
+# Slurm's time limit and scancel send SIGTERM first: the task keeps every finished row, writes
+# its aggregate marked incomplete and exits 143; resubmitting it completes the shard.
+#
 #SBATCH --job-name=mergesim-sweep
 #SBATCH --array=0-15
 #SBATCH --cpus-per-task=8
@@ -26,4 +31,4 @@ merge_sim sweep \
     --scenario urgent_merge --planner pf-iso --runs 10000 --seed 42 \
     --threads "${SLURM_CPUS_PER_TASK:-1}" --quiet \
     --json "$OUT/shard_${SLURM_ARRAY_TASK_ID}.json" \
-    --jsonl "$OUT/shard_${SLURM_ARRAY_TASK_ID}.jsonl"
+    --jsonl "$OUT/shard_${SLURM_ARRAY_TASK_ID}.jsonl" --resume
