@@ -472,3 +472,18 @@ fn the_readme_limits_section_is_the_output_of_merge_sim_limits() {
     );
     assert!(printed.contains("`[sim.tracker]` `lookahead_min_m`"));
 }
+
+#[test]
+fn every_experiment_scenario_loads() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/experiments");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            mergesim::scenarios::Scenario::load(path.to_str().unwrap())
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            count += 1;
+        }
+    }
+    assert!(count >= 4, "{count} experiment scenarios");
+}
