@@ -23,6 +23,7 @@ pub mod planners;
 pub mod polyline;
 pub mod potential_field;
 pub mod prediction;
+pub mod request;
 pub mod road;
 pub mod road_field;
 pub mod speed_optimisation;

@@ -8,11 +8,7 @@
 //! Same configuration + same seed ⇒ bitwise identical results: vehicles are visited by index,
 //! every map is ordered, and the only randomness (V2V drops) comes from a seeded stream.
 
-use std::time::Instant;
-
-use mergesim_types::{
-    Decision, GridSpec, Neighbour, Observation, PathPoint, SharedLocalPath, VehicleId, VehicleState,
-};
+use mergesim_types::{PathPoint, SharedLocalPath, VehicleId};
 use vehicles::{Kinematics, PhysicsWorld};
 
 use crate::agent::Agent;
@@ -20,7 +16,7 @@ use crate::config::{SimConfig, VehicleSpec};
 use crate::drivers::lane_path;
 use crate::error::SimError;
 use crate::metrics::{MetricsSample, VehicleMetrics};
-use crate::observer::{PlanView, TickObserver, VehicleView};
+use crate::observer::{TickObserver, VehicleView};
 use crate::outcome::{PlannerStats, RunOutcome};
 use crate::recording::{EventLevel, Recorder};
 use crate::recording_observer::RecordingObserver;
@@ -28,6 +24,8 @@ use crate::registry::BehaviourRegistry;
 use crate::run_log::RunLog;
 use crate::safety::{BodyState, SafetyMonitor};
 use crate::v2v::V2vBus;
+
+mod planning;
 
 /// Options of one run that are not part of the scenario.
 #[derive(Clone, Debug, Default)]
@@ -345,129 +343,6 @@ impl World {
 
     fn names(&self) -> Vec<String> {
         self.agents.iter().map(|a| a.spec.name.clone()).collect()
-    }
-
-    fn plan_all(&mut self, t_s: f64) -> Result<(), SimError> {
-        let kins: Vec<Kinematics> = self
-            .agents
-            .iter()
-            .map(|a| a.vehicle.kinematics(&self.physics))
-            .collect();
-        let states: Vec<VehicleState> = kins
-            .iter()
-            .map(|k| VehicleState {
-                x_m: k.x_m,
-                y_m: k.y_m,
-                yaw_rad: k.yaw_rad,
-                speed_mps: k.speed_mps,
-            })
-            .collect();
-        let field_due = self.step_index.is_multiple_of(self.steps_per_field);
-        // The observation borrows these while the world records events.
-        let road = self.config.road.clone();
-        let mu = self.config.mu;
-        let mut broadcasts: Vec<SharedLocalPath> = Vec::new();
-        for index in 0..self.agents.len() {
-            check_finite(t_s, &self.agents[index].spec.name, &kins[index])?;
-            let neighbours: Vec<Neighbour> = self
-                .agents
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != index)
-                .map(|(j, other)| Neighbour {
-                    id: other.id,
-                    state: states[j],
-                    shape: other.shape,
-                })
-                .collect();
-            let agent = &self.agents[index];
-            let shared_paths = if agent.spec.connected {
-                self.bus.fresh_paths(agent.id, t_s)
-            } else {
-                Vec::new()
-            };
-            let observation = Observation {
-                time_s: t_s,
-                ego_id: agent.id,
-                ego: states[index],
-                ego_shape: agent.shape,
-                target_speed_mps: agent.spec.target_speed_mps,
-                mu,
-                road: &road,
-                neighbours: &neighbours,
-                shared_paths: &shared_paths,
-            };
-            let agent = &mut self.agents[index];
-            let is_planner = agent.behaviour.is_planner();
-            let started = Instant::now();
-            let decision: Decision =
-                agent
-                    .behaviour
-                    .plan(&observation)
-                    .map_err(|source| SimError::Behaviour {
-                        vehicle: agent.spec.name.clone(),
-                        source,
-                    })?;
-            let elapsed_us = started.elapsed().as_secs_f64() * 1e6;
-            let name = agent.spec.name.clone();
-            let connected = agent.spec.connected;
-            if is_planner {
-                self.plan_times_us.push(elapsed_us);
-                if decision.degraded_mode.is_some() {
-                    self.degraded_plans += 1;
-                }
-                if decision.degraded_mode != self.agents[index].degraded_mode {
-                    let text = match (&decision.degraded_mode, &self.agents[index].degraded_mode) {
-                        (Some(mode), _) => {
-                            format!("t = {t_s:.2} s: {name} plans in degraded mode {mode}")
-                        }
-                        (None, Some(mode)) => {
-                            format!("t = {t_s:.2} s: {name} left degraded mode {mode}")
-                        }
-                        (None, None) => String::new(),
-                    };
-                    self.agents[index].degraded_mode = decision.degraded_mode.clone();
-                    self.event(text, EventLevel::Warn)?;
-                }
-                if let Some(reason) = &decision.fallback {
-                    self.fallbacks += 1;
-                    self.event(
-                        format!("t = {t_s:.2} s: planner fallback of {name}: {reason}"),
-                        EventLevel::Warn,
-                    )?;
-                }
-                let behaviour = &self.agents[index].behaviour;
-                let field = |spec: &GridSpec| behaviour.potential_field(&observation, spec);
-                let view = PlanView {
-                    name: &name,
-                    observation: &observation,
-                    decision: &decision,
-                    field: &field,
-                    field_due,
-                };
-                self.run_log.on_plan(t_s, &view)?;
-                self.recording.on_plan(t_s, &view)?;
-                for observer in &mut self.observers {
-                    observer.on_plan(t_s, &view)?;
-                }
-            }
-            let agent = &mut self.agents[index];
-            agent.path = decision.path;
-            if connected && let Some(message) = decision.broadcast {
-                broadcasts.push(message);
-            }
-        }
-        // Broadcast after everybody planned on the same information (a synchronous round).
-        let receivers: Vec<VehicleId> = self
-            .agents
-            .iter()
-            .filter(|a| a.spec.connected)
-            .map(|a| a.id)
-            .collect();
-        for message in &broadcasts {
-            self.bus.broadcast(t_s, message, &receivers);
-        }
-        Ok(())
     }
 
     fn log_instant(
