@@ -74,11 +74,9 @@ fn unsafe_rear_end_is_reported_by_parry_at_the_right_time() {
     assert!(!outcome.safety.near_miss, "a collision is not a near miss");
 }
 
-#[test]
-fn same_scenario_and_seed_give_bitwise_identical_runs() {
-    let scenario = Scenario::load("urgent_merge").unwrap();
-    let a = run(&scenario, None, true);
-    let b = run(&scenario, None, true);
+/// The bits of every time-series row, the safety results and the per-vehicle metrics of two
+/// runs are equal.
+fn assert_bitwise_equal(a: &RunOutcome, b: &RunOutcome) {
     assert_eq!(a.time_series.len(), b.time_series.len());
     for (ra, rb) in a.time_series.iter().zip(&b.time_series) {
         let bits = |r: &mergesim::sim::TimeSeriesRow| {
@@ -101,6 +99,33 @@ fn same_scenario_and_seed_give_bitwise_identical_runs() {
     assert_eq!(a.safety, b.safety);
     assert_eq!(a.vehicles, b.vehicles);
     assert_eq!(a.planner_stats.plans, b.planner_stats.plans);
+    assert_eq!(a.events, b.events);
+}
+
+#[test]
+fn same_scenario_and_seed_give_bitwise_identical_runs() {
+    let scenario = Scenario::load("urgent_merge").unwrap();
+    let a = run(&scenario, None, true);
+    let b = run(&scenario, None, true);
+    assert_bitwise_equal(&a, &b);
+}
+
+/// The vehicles plan in parallel on rayon's pool: one thread or several, the same bits.
+#[test]
+fn planning_in_parallel_gives_the_one_thread_results() {
+    let scenario = Scenario::load("dense_merge").unwrap();
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .stack_size(16 << 20)
+            .build()
+            .unwrap()
+            .install(|| run(&scenario, None, true))
+    };
+    let one = on(1);
+    assert_eq!(one.vehicles.len(), 6);
+    assert_bitwise_equal(&one, &on(2));
+    assert_bitwise_equal(&one, &on(4));
 }
 
 /// Regression: the SCP of Eq. 10 must settle on the optimum, not jump across it. Before the

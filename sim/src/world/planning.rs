@@ -1,6 +1,8 @@
-//! Step 2 of the tick: every vehicle whose planning period has come observes, decides and
-//! broadcasts (vehicles visited by id); decisions are counted, fallbacks and degraded modes
-//! logged, and the observers see each plan.
+//! Step 2 of the tick: every vehicle observes, decides and broadcasts. The observations are
+//! built and the decisions handled (counted, fallbacks and degraded modes logged, observers
+//! called, broadcasts sent) in id order; the decisions themselves are computed in parallel on
+//! rayon's pool (the sweep's pool inside a sweep), which changes no result: each depends only
+//! on its vehicle's behaviour and observation.
 
 use std::time::Instant;
 
@@ -9,7 +11,10 @@ use mergesim_types::{
 };
 use vehicles::Kinematics;
 
+use rayon::prelude::*;
+
 use super::{World, check_finite};
+use crate::agent::Agent;
 use crate::error::SimError;
 use crate::observer::{PlanView, TickObserver};
 use crate::recording::EventLevel;
@@ -35,6 +40,9 @@ impl World {
         let road = self.config.road.clone();
         let mu = self.config.mu;
         let mut broadcasts: Vec<SharedLocalPath> = Vec::new();
+        // 1. What each vehicle perceives and has received (sequential, by id).
+        let mut inputs: Vec<(Vec<Neighbour>, Vec<SharedLocalPath>)> =
+            Vec::with_capacity(self.agents.len());
         for index in 0..self.agents.len() {
             check_finite(t_s, &self.agents[index].spec.name, &kins[index])?;
             let neighbours: Vec<Neighbour> = self
@@ -54,29 +62,45 @@ impl World {
             } else {
                 Vec::new()
             };
-            let observation = Observation {
-                time_s: t_s,
-                ego_id: agent.id,
-                ego: states[index],
-                ego_shape: agent.shape,
-                target_speed_mps: agent.spec.target_speed_mps,
-                mu,
-                road: &road,
-                neighbours: &neighbours,
-                shared_paths: &shared_paths,
-            };
-            let agent = &mut self.agents[index];
+            inputs.push((neighbours, shared_paths));
+        }
+        let observation_of = |index: usize, agent: &Agent| Observation {
+            time_s: t_s,
+            ego_id: agent.id,
+            ego: states[index],
+            ego_shape: agent.shape,
+            target_speed_mps: agent.spec.target_speed_mps,
+            mu,
+            road: &road,
+            neighbours: &inputs[index].0,
+            shared_paths: &inputs[index].1,
+        };
+        // 2. Every vehicle decides, in parallel: a decision depends only on its own behaviour
+        // and observation, so the results are those of one thread, bit for bit.
+        let decided: Vec<(Result<Decision, SimError>, f64)> = self
+            .agents
+            .par_iter_mut()
+            .enumerate()
+            .map(|(index, agent)| {
+                let observation = observation_of(index, agent);
+                let started = Instant::now();
+                let decision =
+                    agent
+                        .behaviour
+                        .plan(&observation)
+                        .map_err(|source| SimError::Behaviour {
+                            vehicle: agent.spec.name.clone(),
+                            source,
+                        });
+                (decision, started.elapsed().as_secs_f64() * 1e6)
+            })
+            .collect();
+        // 3. Counting, events, observers and broadcasts (sequential, by id).
+        for (index, (decision, elapsed_us)) in decided.into_iter().enumerate() {
+            let decision = decision?;
+            let observation = observation_of(index, &self.agents[index]);
+            let agent = &self.agents[index];
             let is_planner = agent.behaviour.is_planner();
-            let started = Instant::now();
-            let decision: Decision =
-                agent
-                    .behaviour
-                    .plan(&observation)
-                    .map_err(|source| SimError::Behaviour {
-                        vehicle: agent.spec.name.clone(),
-                        source,
-                    })?;
-            let elapsed_us = started.elapsed().as_secs_f64() * 1e6;
             let name = agent.spec.name.clone();
             let connected = agent.spec.connected;
             if is_planner {
