@@ -43,8 +43,8 @@ impl World {
         // 1. What each vehicle perceives and has received (sequential, by id).
         let mut inputs: Vec<(Vec<Neighbour>, Vec<SharedLocalPath>)> =
             Vec::with_capacity(self.agents.len());
-        for index in 0..self.agents.len() {
-            check_finite(t_s, &self.agents[index].spec.name, &kins[index])?;
+        for (index, kin) in kins.iter().enumerate() {
+            check_finite(t_s, &self.agents[index].spec.name, kin)?;
             let neighbours: Vec<Neighbour> = self
                 .agents
                 .iter()
