@@ -25,6 +25,8 @@ pub struct InstanceOptions {
     /// Stop the run (with [`sim::SimError::Interrupted`]) once this flag is set, e.g. by a
     /// SIGINT/SIGTERM handler.
     pub interrupt: Option<Arc<AtomicBool>>,
+    /// Time each phase of the tick (`RunSummary::profile`).
+    pub profile: bool,
 }
 
 /// Why a run did not finish.
@@ -84,6 +86,7 @@ pub fn run_instance(
         planner_override: options.planner.clone(),
         seed: options.seed.unwrap_or(0),
         keep_time_series: options.keep_time_series,
+        profile: options.profile,
     };
     let world = World::with_registry(
         instance.sim,

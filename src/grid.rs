@@ -245,6 +245,7 @@ fn run_job(
         seed: job.seed,
         keep_time_series: false,
         interrupt,
+        profile: false,
     };
     let result = run_quietly(&cell_scenario, &options).map(|finished| finished.outcome);
     let (collisions, error, vehicles) = match result {

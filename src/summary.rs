@@ -36,6 +36,9 @@ pub struct RunSummary {
     pub planner_stats: PlannerStats,
     /// Collision and safety events, in time order.
     pub events: Vec<String>,
+    /// Wall time per phase of the tick (`merge_sim run --profile`); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<sim::profile::ProfileReport>,
 }
 
 impl RunSummary {
@@ -63,6 +66,7 @@ impl RunSummary {
             vehicles: outcome.vehicles.clone(),
             planner_stats: outcome.planner_stats.clone(),
             events: outcome.events.clone(),
+            profile: outcome.profile.clone(),
         }
     }
 

@@ -187,6 +187,7 @@ pub fn simulate_instance_until(
         seed: Some(seed),
         keep_time_series: false,
         interrupt,
+        profile: false,
     };
     crate::experiment::run_quietly(&plan.scenario, &options)
         .map(|finished| finished.summary)

@@ -325,3 +325,62 @@ fn two_runs_write_identical_json_but_for_wall_clock_fields() {
     let b = read("b.json");
     assert_eq!(a, b);
 }
+
+#[test]
+fn run_profile_says_where_the_wall_time_went() {
+    let dir = scratch("profile");
+    let json = dir.join("run.json");
+    let out = merge_sim(&[
+        "run",
+        "--no-rrd",
+        "--profile",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("where the wall time went"), "{text}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let phases = v["profile"]["phases"].as_array().unwrap();
+    let names: Vec<&str> = phases
+        .iter()
+        .map(|p| p["phase"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "v2v",
+            "planning",
+            "tracking",
+            "tire_forces",
+            "physics",
+            "safety",
+            "metrics",
+            "recording"
+        ]
+    );
+    let wall = |name: &str| {
+        phases.iter().find(|p| p["phase"] == name).unwrap()["wall_s"]
+            .as_f64()
+            .unwrap()
+    };
+    // Two vehicles plan 250 times each and rapier steps 12,500 times: both take time; nothing
+    // is recorded.
+    assert!(wall("planning") > 0.0 && wall("physics") > 0.0);
+    let total: f64 = phases.iter().map(|p| p["wall_s"].as_f64().unwrap()).sum();
+    assert!(wall("recording") < 0.01 * total, "{phases:?}");
+    assert!(total <= v["wall_time_s"].as_f64().unwrap() * 1.01 + 1e-3);
+    // Without --profile there is no profile.
+    let out = merge_sim(&[
+        "run",
+        "--no-rrd",
+        "--quiet",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(v.get("profile").is_none());
+}

@@ -13,6 +13,7 @@ pub mod metrics;
 pub mod observer;
 pub mod outcome;
 pub mod paper_metrics;
+pub mod profile;
 pub mod recording;
 pub mod recording_observer;
 pub mod registry;

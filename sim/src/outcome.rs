@@ -106,4 +106,7 @@ pub struct RunOutcome {
     pub time_series: Vec<TimeSeriesRow>,
     /// Event log lines (collisions, near misses, fallbacks), in time order.
     pub events: Vec<String>,
+    /// Wall time per phase of the tick, if `RunOptions::profile` asked for it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<crate::profile::ProfileReport>,
 }

@@ -8,6 +8,8 @@
 //! Same configuration + same seed ⇒ bitwise identical results: vehicles are visited by index,
 //! every map is ordered, and the only randomness (V2V drops) comes from a seeded stream.
 
+use std::time::Duration;
+
 use mergesim_types::{PathPoint, SharedLocalPath, VehicleId};
 use vehicles::{Kinematics, PhysicsWorld};
 
@@ -18,6 +20,7 @@ use crate::error::SimError;
 use crate::metrics::{MetricsSample, VehicleMetrics};
 use crate::observer::{TickObserver, VehicleView};
 use crate::outcome::{PlannerStats, RunOutcome};
+use crate::profile::{Phase, Profiler};
 use crate::recording::{EventLevel, Recorder};
 use crate::recording_observer::RecordingObserver;
 use crate::registry::BehaviourRegistry;
@@ -36,6 +39,8 @@ pub struct RunOptions {
     pub seed: u64,
     /// Keep the time series in the outcome (for `--csv`).
     pub keep_time_series: bool,
+    /// Time each phase of the tick (`RunOutcome::profile`).
+    pub profile: bool,
 }
 
 /// The simulation.
@@ -59,6 +64,7 @@ pub struct World {
     steps_per_safety: u64,
     reported_collisions: usize,
     reported_edge_contacts: usize,
+    profiler: Profiler,
 }
 
 fn steps_for(period_s: f64, dt_s: f64) -> u64 {
@@ -137,6 +143,7 @@ impl World {
             fallbacks: 0,
             degraded_plans: 0,
             step_index: 0,
+            profiler: Profiler::new(options.profile),
             reported_collisions: 0,
             reported_edge_contacts: 0,
         })
@@ -188,14 +195,19 @@ impl World {
     pub fn step(&mut self) -> Result<(), SimError> {
         let t_s = self.time_s();
         // 1. V2V delivery.
+        let started = self.profiler.start();
         self.bus.deliver(t_s);
+        self.profiler.stop(Phase::V2v, started);
         // 2. Planning, by id.
         if self.step_index.is_multiple_of(self.steps_per_plan) {
+            // Timed inside (the observers' share goes to metrics and recording).
             self.plan_all(t_s)?;
         }
         // 3.–4. Tracking, forces.
         let dt_s = self.config.dt_s;
+        let (mut tracking, mut forces) = (Duration::ZERO, Duration::ZERO);
         for agent in &mut self.agents {
+            let started = self.profiler.start();
             let kin = agent.vehicle.kinematics(&self.physics);
             if agent.path.is_empty() {
                 let v = agent.spec.target_speed_mps;
@@ -210,17 +222,27 @@ impl World {
             }
             let controls = agent.tracker.update(&kin, &agent.path, dt_s);
             agent.vehicle.set_controls(controls);
+            let tracked = self.profiler.start();
             agent
                 .vehicle
                 .apply_forces(&mut self.physics, self.config.mu);
+            if let (Some(started), Some(tracked)) = (started, tracked) {
+                tracking += tracked - started;
+                forces += tracked.elapsed();
+            }
         }
+        self.profiler.add(Phase::Tracking, tracking);
+        self.profiler.add(Phase::TireForces, forces);
+        let started = self.profiler.start();
         self.physics.step();
+        self.profiler.stop(Phase::Physics, started);
         self.step_index += 1;
         let t_s = self.time_s();
         // 5. Safety checks.
         let need_log = self.step_index.is_multiple_of(self.steps_per_log);
         let need_safety = self.step_index.is_multiple_of(self.steps_per_safety);
         if need_safety || need_log {
+            let started = self.profiler.start();
             let kins: Vec<Kinematics> = self
                 .agents
                 .iter()
@@ -247,6 +269,7 @@ impl World {
                     })?;
                 self.report_new_collisions()?;
             }
+            self.profiler.stop(Phase::Safety, started);
             // 6. Observers.
             if need_log {
                 self.log_instant(t_s, &kins, &bodies)?;
@@ -409,11 +432,15 @@ impl World {
                 received: &received[i],
             })
             .collect();
+        let started = self.profiler.start();
         self.run_log.on_log(t_s, &views)?;
-        self.recording.on_log(t_s, &views)?;
         for observer in &mut self.observers {
             observer.on_log(t_s, &views)?;
         }
+        self.profiler.stop(Phase::Metrics, started);
+        let started = self.profiler.start();
+        self.recording.on_log(t_s, &views)?;
+        self.profiler.stop(Phase::Recording, started);
         Ok(())
     }
 
@@ -453,6 +480,7 @@ impl World {
             planner_stats,
             v2v,
             time_series: self.run_log.into_time_series(),
+            profile: self.profiler.report(),
             events: self.events,
         })
     }

@@ -27,6 +27,7 @@ pub fn simulate(
         seed: Some(seed),
         keep_time_series,
         interrupt: None,
+        profile: false,
     };
     run_quietly(&nominal, &options)
         .unwrap_or_else(|e| panic!("{}: {e}", scenario.name))

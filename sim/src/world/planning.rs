@@ -4,7 +4,7 @@
 //! rayon's pool (the sweep's pool inside a sweep), which changes no result: each depends only
 //! on its vehicle's behaviour and observation.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use mergesim_types::{
     Decision, GridSpec, Neighbour, Observation, SharedLocalPath, VehicleId, VehicleState,
@@ -17,10 +17,13 @@ use super::{World, check_finite};
 use crate::agent::Agent;
 use crate::error::SimError;
 use crate::observer::{PlanView, TickObserver};
+use crate::profile::Phase;
 use crate::recording::EventLevel;
 
 impl World {
     pub(super) fn plan_all(&mut self, t_s: f64) -> Result<(), SimError> {
+        let started = self.profiler.start();
+        let (mut metrics, mut recording) = (Duration::ZERO, Duration::ZERO);
         let kins: Vec<Kinematics> = self
             .agents
             .iter()
@@ -137,10 +140,16 @@ impl World {
                     field: &field,
                     field_due,
                 };
+                let observed = self.profiler.start();
                 self.run_log.on_plan(t_s, &view)?;
-                self.recording.on_plan(t_s, &view)?;
                 for observer in &mut self.observers {
                     observer.on_plan(t_s, &view)?;
+                }
+                let recorded = self.profiler.start();
+                self.recording.on_plan(t_s, &view)?;
+                if let (Some(observed), Some(recorded)) = (observed, recorded) {
+                    metrics += recorded - observed;
+                    recording += recorded.elapsed();
                 }
             }
             let agent = &mut self.agents[index];
@@ -158,6 +167,14 @@ impl World {
             .collect();
         for message in &broadcasts {
             self.bus.broadcast(t_s, message, &receivers);
+        }
+        if let Some(started) = started {
+            self.profiler.add(
+                Phase::Planning,
+                started.elapsed().saturating_sub(metrics + recording),
+            );
+            self.profiler.add(Phase::Metrics, metrics);
+            self.profiler.add(Phase::Recording, recording);
         }
         Ok(())
     }

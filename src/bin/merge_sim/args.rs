@@ -85,6 +85,10 @@ pub(crate) struct RunArgs {
     /// Write the time series (one row per vehicle per logged instant) here.
     #[arg(long, value_name = "PATH")]
     pub(crate) csv: Option<PathBuf>,
+    /// Time each phase of the tick (V2V, planning, tracking, tire forces, physics, safety,
+    /// metrics, recording) and print where the run's wall time went; also in --json.
+    #[arg(long)]
+    pub(crate) profile: bool,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub(crate) quiet: bool,

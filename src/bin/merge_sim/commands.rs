@@ -15,8 +15,8 @@ use crate::args::{
 };
 use crate::signals::Interrupt;
 use crate::{
-    Failure, input, interrupted, load_scenario, out, outln, run_failure, simulate, sweep_failure,
-    write_output,
+    Failure, Simulation, input, interrupted, load_scenario, out, outln, run_failure, simulate,
+    sweep_failure, write_output,
 };
 
 pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failure> {
@@ -44,15 +44,15 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
         }
     }
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
-    let finished = simulate(
-        &scenario,
-        args.planner,
-        args.seed,
-        rrd.as_deref(),
-        args.csv.is_some(),
+    let what = Simulation {
+        planner: args.planner,
+        seed: args.seed,
+        rrd: rrd.as_deref(),
+        keep_time_series: args.csv.is_some(),
         show_progress,
-        interrupt,
-    )?;
+        profile: args.profile,
+    };
+    let finished = simulate(&scenario, &what, interrupt)?;
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&finished.summary).map_err(run_failure)?;
         write_atomically(path, text.as_bytes())
@@ -69,6 +69,9 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
         out!("{}", finished.summary.table());
         for event in &finished.summary.events {
             outln!("event: {event}");
+        }
+        if let Some(profile) = &finished.summary.profile {
+            out!("\nwhere the wall time went:\n{}", profile.table());
         }
         if let Some(path) = &rrd {
             outln!(
@@ -104,15 +107,14 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
     let mut summaries = Vec::new();
     let mut time_series = Vec::new();
     for &kind in &args.planners {
-        let finished = simulate(
-            &scenario,
-            Some(kind),
-            args.seed,
-            None,
-            args.plots.is_some(),
+        let what = Simulation {
+            planner: Some(kind),
+            seed: args.seed,
+            keep_time_series: args.plots.is_some(),
             show_progress,
-            interrupt,
-        )?;
+            ..Simulation::default()
+        };
+        let finished = simulate(&scenario, &what, interrupt)?;
         summaries.push(finished.summary);
         time_series.push(finished.outcome.time_series);
     }

@@ -133,17 +133,38 @@ fn progress_printer(enabled: bool, label: String) -> impl FnMut(f64) {
     }
 }
 
+/// What one `simulate` call runs and keeps.
+#[derive(Default)]
+pub(crate) struct Simulation<'a> {
+    /// Planner override.
+    pub(crate) planner: Option<PlannerKind>,
+    /// Instance seed (None: the nominal scenario).
+    pub(crate) seed: Option<u64>,
+    /// Recording path.
+    pub(crate) rrd: Option<&'a std::path::Path>,
+    /// Keep the time series (CSV, figures).
+    pub(crate) keep_time_series: bool,
+    /// A progress line on stderr.
+    pub(crate) show_progress: bool,
+    /// Time the phases of the tick.
+    pub(crate) profile: bool,
+}
+
 /// Runs one instance of `scenario` (the library's `run_instance`), with a progress line on a
 /// terminal: a scenario the world refuses is bad input, a failure while running is not.
 pub(crate) fn simulate(
     scenario: &Scenario,
-    planner: Option<PlannerKind>,
-    seed: Option<u64>,
-    rrd: Option<&std::path::Path>,
-    keep_time_series: bool,
-    show_progress: bool,
+    what: &Simulation<'_>,
     interrupt: &signals::Interrupt,
 ) -> Result<Finished, Failure> {
+    let Simulation {
+        planner,
+        seed,
+        rrd,
+        keep_time_series,
+        show_progress,
+        profile,
+    } = *what;
     let planner = planner.map(|k| k.name().to_string());
     let label = planner_label(scenario, planner.as_deref());
     let recorder = match rrd {
@@ -157,6 +178,7 @@ pub(crate) fn simulate(
         seed,
         keep_time_series,
         interrupt: Some(interrupt.flag.clone()),
+        profile,
     };
     let progress = progress_printer(show_progress, format!("{} {label}", scenario.name));
     run_instance(
