@@ -384,3 +384,63 @@ fn run_profile_says_where_the_wall_time_went() {
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert!(v.get("profile").is_none());
 }
+
+#[test]
+fn a_large_recording_is_announced_before_it_is_written() {
+    let dir = scratch("large_recording");
+    let rrd = dir.join("platoon.rrd");
+    // Fields and received paths of all 50 vehicles: about 1 GB. Stopped by SIGTERM after
+    // three seconds, long before it is written.
+    let out = Command::new("timeout")
+        .args(["-s", "TERM", "3"])
+        .arg(env!("CARGO_BIN_EXE_merge_sim"))
+        .args([
+            "run",
+            "--quiet",
+            "--scenario",
+            "platoon_merge_50",
+            "--record-detail",
+            "all",
+            "--rrd",
+            rrd.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    let warning = err.lines().next().unwrap_or_default();
+    assert!(
+        warning.starts_with("warning: the recording") && warning.contains("MB"),
+        "{err}"
+    );
+    let megabytes: f64 = warning
+        .split("about ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap();
+    assert!(megabytes > 500.0, "{warning}");
+    assert_eq!(
+        out.status.code(),
+        Some(124),
+        "timeout's code for a stopped child: {err}"
+    );
+    assert!(
+        std::fs::read_dir(&dir).unwrap().next().is_none(),
+        "nothing left"
+    );
+    // The default detail keeps the same run well below the threshold: no warning.
+    let out = Command::new("timeout")
+        .args(["-s", "TERM", "1"])
+        .arg(env!("CARGO_BIN_EXE_merge_sim"))
+        .args([
+            "run",
+            "--quiet",
+            "--scenario",
+            "platoon_merge_50",
+            "--rrd",
+            rrd.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
+}

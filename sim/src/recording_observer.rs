@@ -28,14 +28,18 @@ fn field_grid(x_m: f64, road: &mergesim_types::MergeRoad) -> GridSpec {
 /// Writes a run into a [`Recorder`] (a disabled one makes this a no-op).
 pub struct RecordingObserver {
     recorder: Option<Recorder>,
+    /// Fields and received paths for vehicle ids below this (`RecorderParams::detail_vehicles`).
+    detail_below: usize,
 }
 
 impl RecordingObserver {
     /// Records into `recorder`, starting with the road.
     pub fn new(mut recorder: Recorder, road: &mergesim_types::MergeRoad) -> Result<Self, SimError> {
         recorder.log_road(road).map_err(rec)?;
+        let detail_below = recorder.params().detail_vehicles.unwrap_or(usize::MAX);
         Ok(Self {
             recorder: Some(recorder),
+            detail_below,
         })
     }
 
@@ -50,7 +54,7 @@ impl TickObserver for RecordingObserver {
     }
 
     fn on_plan(&mut self, _t_s: f64, plan: &PlanView<'_, '_>) -> Result<(), SimError> {
-        if !plan.field_due {
+        if !plan.field_due || plan.observation.ego_id as usize >= self.detail_below {
             return Ok(());
         }
         let Some(recorder) = self.enabled() else {
@@ -74,6 +78,7 @@ impl TickObserver for RecordingObserver {
     }
 
     fn on_log(&mut self, t_s: f64, vehicles: &[VehicleView<'_>]) -> Result<(), SimError> {
+        let detail_below = self.detail_below;
         let Some(recorder) = self.enabled() else {
             return Ok(());
         };
@@ -96,7 +101,7 @@ impl TickObserver for RecordingObserver {
                 )
                 .map_err(rec)?;
             recorder.log_planned_path(v.name, v.path).map_err(rec)?;
-            if v.connected {
+            if v.connected && (v.id as usize) < detail_below {
                 recorder
                     .log_received_paths(v.name, v.received)
                     .map_err(rec)?;

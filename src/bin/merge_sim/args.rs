@@ -85,6 +85,11 @@ pub(crate) struct RunArgs {
     /// Write the time series (one row per vehicle per logged instant) here.
     #[arg(long, value_name = "PATH")]
     pub(crate) csv: Option<PathBuf>,
+    /// Record potential fields and received shared paths for the first N vehicles only (by
+    /// their order in the scenario), or for `all`; boxes, planned paths, time series and events
+    /// are recorded for every vehicle.
+    #[arg(long, value_name = "N|all", default_value = "4", value_parser = parse_record_detail)]
+    pub(crate) record_detail: RecordDetail,
     /// Time each phase of the tick (V2V, planning, tracking, tire forces, physics, safety,
     /// metrics, recording) and print where the run's wall time went; also in --json.
     #[arg(long)]
@@ -301,4 +306,17 @@ pub(crate) fn parse_gap(text: &str) -> Result<f64, String> {
         Ok(v) if v.is_finite() && (0.0..=10.0).contains(&v) => Ok(v),
         _ => Err("expected a time gap in [0, 10] s".into()),
     }
+}
+
+/// How many vehicles get fields and received paths in the recording.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct RecordDetail(pub(crate) Option<usize>);
+
+pub(crate) fn parse_record_detail(text: &str) -> Result<RecordDetail, String> {
+    if text == "all" {
+        return Ok(RecordDetail(None));
+    }
+    text.parse::<usize>()
+        .map(|n| RecordDetail(Some(n)))
+        .map_err(|_| "expected a number of vehicles or `all`".into())
 }

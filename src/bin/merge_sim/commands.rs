@@ -19,6 +19,9 @@ use crate::{
     sweep_failure, write_output,
 };
 
+/// Recordings estimated above this size are announced before they are written.
+const RECORDING_WARNING_BYTES: f64 = 500e6;
+
 pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failure> {
     use mergesim::output::file_name_part;
     let scenario = load_scenario(&args.source.scenario, args.source.params)?;
@@ -43,6 +46,25 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
             check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
         }
     }
+    if let Some(path) = &rrd {
+        let instance = scenario.instance(args.seed);
+        let bytes = sim::recording::size_estimate::estimated_bytes(
+            &instance.sim,
+            &instance.vehicles,
+            args.record_detail.0,
+        );
+        if bytes > RECORDING_WARNING_BYTES {
+            eprintln!(
+                "warning: the recording {} will be about {:.0} MB ({} vehicles, {} s); \
+                 --record-detail 2 (fields and received paths of fewer vehicles) or --no-rrd \
+                 make it smaller",
+                path.display(),
+                bytes / 1e6,
+                instance.vehicles.len(),
+                instance.sim.duration_s
+            );
+        }
+    }
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let what = Simulation {
         planner: args.planner,
@@ -51,6 +73,7 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
         keep_time_series: args.csv.is_some(),
         show_progress,
         profile: args.profile,
+        record_detail: args.record_detail.0,
     };
     let finished = simulate(&scenario, &what, interrupt)?;
     if let Some(path) = &args.json {

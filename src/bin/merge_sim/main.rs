@@ -22,7 +22,7 @@ use mergesim::output::write_atomically;
 use planner::{ParameterSet, PlannerKind};
 use scenarios::Scenario;
 use sim::BehaviourRegistry;
-use sim::recording::Recorder;
+use sim::recording::{Recorder, RecorderParams};
 
 use crate::args::{Cli, Command};
 
@@ -148,6 +148,8 @@ pub(crate) struct Simulation<'a> {
     pub(crate) show_progress: bool,
     /// Time the phases of the tick.
     pub(crate) profile: bool,
+    /// Vehicles with fields and received paths in the recording (None: all).
+    pub(crate) record_detail: Option<usize>,
 }
 
 /// Runs one instance of `scenario` (the library's `run_instance`), with a progress line on a
@@ -164,13 +166,21 @@ pub(crate) fn simulate(
         keep_time_series,
         show_progress,
         profile,
+        record_detail,
     } = *what;
     let planner = planner.map(|k| k.name().to_string());
     let label = planner_label(scenario, planner.as_deref());
     let recorder = match rrd {
-        Some(path) => Recorder::new_file(path, "mergesim")
-            .with_context(|| format!("cannot create recording {}", path.display()))
-            .map_err(run_failure)?,
+        Some(path) => Recorder::new_file_with_params(
+            path,
+            "mergesim",
+            RecorderParams {
+                detail_vehicles: record_detail,
+                ..RecorderParams::default()
+            },
+        )
+        .with_context(|| format!("cannot create recording {}", path.display()))
+        .map_err(run_failure)?,
         None => Recorder::disabled(),
     };
     let options = InstanceOptions {
