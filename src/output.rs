@@ -76,6 +76,16 @@ pub fn check_output_path(path: &Path, what: &str) -> Result<(), String> {
     if path.as_os_str().is_empty() {
         return Err(format!("{what}: empty path"));
     }
+    if path
+        .as_os_str()
+        .to_string_lossy()
+        .ends_with(std::path::is_separator)
+    {
+        return Err(format!(
+            "{what} {}: ends with a path separator, so it names a folder, not a file",
+            path.display()
+        ));
+    }
     match std::fs::symlink_metadata(path) {
         Ok(meta) if !meta.file_type().is_file() => {
             return Err(format!(
@@ -120,6 +130,47 @@ pub fn check_output_path(path: &Path, what: &str) -> Result<(), String> {
     }
 }
 
+/// Where `path` (an output, which may not exist yet) would be: its folder resolved (links,
+/// `..`) and its file name; `None` if the folder cannot be resolved.
+fn resolved_output(path: &Path) -> Option<PathBuf> {
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    Some(std::fs::canonicalize(parent).ok()?.join(path.file_name()?))
+}
+
+/// Checks that no two outputs are the same file and that no output is one of the inputs
+/// (`outputs`: path and option name; `inputs`: files read): writing one would destroy the
+/// other. Paths are compared after resolving links and `..`.
+pub fn check_distinct(outputs: &[(&Path, &str)], inputs: &[&Path]) -> Result<(), String> {
+    let resolved: Vec<(Option<PathBuf>, &Path, &str)> = outputs
+        .iter()
+        .map(|(path, what)| (resolved_output(path), *path, *what))
+        .collect();
+    for (i, (a, path_a, what_a)) in resolved.iter().enumerate() {
+        let Some(a) = a else { continue };
+        for (b, _, what_b) in &resolved[..i] {
+            if b.as_ref() == Some(a) {
+                return Err(format!(
+                    "{what_a} {}: the same file as {what_b}; give each output its own path",
+                    path_a.display()
+                ));
+            }
+        }
+        for input in inputs {
+            if std::fs::canonicalize(input).ok().as_ref() == Some(a) {
+                return Err(format!(
+                    "{what_a} {}: is the input file {}; writing it would destroy it",
+                    path_a.display(),
+                    input.display()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// A name from a scenario (or planner) made safe as part of a file name in the output folder:
 /// characters other than ASCII letters, digits, `-`, `_` and `.` become `_`, leading dots are
 /// dropped (no hidden files, no `..`), at most 100 characters; empty gives `unnamed`.
@@ -145,6 +196,29 @@ pub fn file_name_part(name: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn outputs_must_differ_from_each_other_and_from_the_inputs() {
+        let dir = std::env::temp_dir().join(format!("mergesim-distinct-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        let input = dir.join("scenario.toml");
+        std::fs::write(&input, "").unwrap();
+        let a = dir.join("a.json");
+        let a_again = dir.join("sub/../a.json");
+        assert!(
+            check_distinct(&[(&a, "--json"), (&dir.join("b.csv"), "--csv")], &[&input]).is_ok()
+        );
+        let err = check_distinct(&[(&a, "--json"), (&a_again, "--csv")], &[]).unwrap_err();
+        assert!(
+            err.contains("--csv") && err.contains("same file as --json"),
+            "{err}"
+        );
+        let err = check_distinct(&[(&input, "--json")], &[&input]).unwrap_err();
+        assert!(err.contains("input file"), "{err}");
+        let err = check_output_path(Path::new("x.json/"), "--json").unwrap_err();
+        assert!(err.contains("names a folder"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn names_from_scenarios_stay_in_the_folder() {

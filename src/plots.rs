@@ -40,7 +40,7 @@ pub const TIME_SERIES_CSV: &str = "time_series.csv";
 
 /// File name of the motion-state figure of one vehicle (paper Fig. 4 is the obstacle's).
 pub fn states_png(vehicle: &str) -> String {
-    format!("states_{vehicle}.png")
+    format!("states_{}.png", crate::output::file_name_part(vehicle))
 }
 
 /// Size of every figure (pixels).
@@ -97,8 +97,10 @@ pub enum PlotError {
     Empty(String),
 }
 
-/// Checks that `dir` is an existing, writable folder (before a long simulation).
-pub fn check_plot_dir(dir: &Path) -> Result<(), String> {
+/// Checks before a long simulation that `dir` is an existing, writable folder (or one that can
+/// be created) and that every file the figures of `vehicles` will be written to is a writable
+/// regular file or new (`output::check_output_path`).
+pub fn check_plot_dir(dir: &Path, vehicles: &[&str]) -> Result<(), String> {
     if dir.as_os_str().is_empty() {
         return Err("--plots: empty path".into());
     }
@@ -128,6 +130,14 @@ pub fn check_plot_dir(dir: &Path) -> Result<(), String> {
     let probe = probe_dir.join(".mergesim_plots_probe.tmp");
     std::fs::write(&probe, b"").map_err(|e| format!("--plots {}: {e}", dir.display()))?;
     let _ = std::fs::remove_file(&probe);
+    if dir.is_dir() {
+        let names = [PATHS_PNG.to_string(), TIME_SERIES_CSV.to_string()]
+            .into_iter()
+            .chain(vehicles.iter().map(|v| states_png(v)));
+        for name in names {
+            crate::output::check_output_path(&dir.join(name), "--plots")?;
+        }
+    }
     Ok(())
 }
 
@@ -434,10 +444,19 @@ mod tests {
 
     #[test]
     fn a_missing_folder_is_rejected() {
-        assert!(check_plot_dir(Path::new("/definitely/not/here")).is_err());
+        assert!(check_plot_dir(Path::new("/definitely/not/here"), &[]).is_err());
         // A missing folder whose parent exists is created later.
-        assert!(check_plot_dir(&std::env::temp_dir().join("mergesim_new_plots")).is_ok());
-        assert!(check_plot_dir(Path::new("")).is_err());
-        assert!(check_plot_dir(&std::env::temp_dir()).is_ok());
+        assert!(check_plot_dir(&std::env::temp_dir().join("mergesim_new_plots"), &[]).is_ok());
+        assert!(check_plot_dir(Path::new(""), &[]).is_err());
+        let dir = std::env::temp_dir().join(format!("mergesim_plot_files_{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("states_ego.png")).unwrap();
+        assert!(check_plot_dir(&dir, &["obstacle"]).is_ok());
+        let err = check_plot_dir(&dir, &["ego"]).unwrap_err();
+        assert!(
+            err.contains("states_ego.png") && err.contains("directory"),
+            "{err}"
+        );
+        assert_eq!(states_png("../a"), "states__a.png");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

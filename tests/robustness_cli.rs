@@ -487,3 +487,166 @@ fn every_experiment_scenario_loads() {
     }
     assert!(count >= 4, "{count} experiment scenarios");
 }
+
+#[test]
+fn inputs_that_are_not_regular_files_are_refused_at_once() {
+    let dir = scratch("robust_inputs");
+    let fifo = dir.join("scenario.toml");
+    assert!(
+        Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    for scenario in [p(&fifo), "/dev/zero", p(&dir)] {
+        let started = Instant::now();
+        let out = merge_sim(&["run", "--no-rrd", "--scenario", scenario]);
+        assert_eq!(out.status.code(), Some(2), "{scenario}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("not a regular file"),
+            "{}",
+            stderr(&out)
+        );
+        assert!(started.elapsed() < Duration::from_secs(5), "{scenario}");
+    }
+}
+
+#[test]
+fn an_output_may_be_neither_another_output_nor_an_input() {
+    let dir = scratch("robust_distinct");
+    let scenario = write(&dir, "scenario.toml", &urgent());
+    let same = dir.join("same.out");
+    let shard = dir.join("shard.json");
+    let out = merge_sim(&["sweep", "--quiet", "--runs", "1", "--json", p(&shard)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let shard_text = std::fs::read_to_string(&shard).unwrap();
+    for (args, needle) in [
+        (
+            vec!["run", "--no-rrd", "--json", p(&same), "--csv", p(&same)],
+            "same file",
+        ),
+        (
+            vec![
+                "run",
+                "--no-rrd",
+                "--scenario",
+                p(&scenario),
+                "--json",
+                p(&scenario),
+            ],
+            "input file",
+        ),
+        (
+            vec![
+                "sweep",
+                "--runs",
+                "1",
+                "--json",
+                p(&same),
+                "--jsonl",
+                p(&same),
+            ],
+            "same file",
+        ),
+        (
+            vec!["merge-results", p(&shard), "--json", p(&shard)],
+            "input file",
+        ),
+        (
+            vec!["run", "--no-rrd", "--json", "x.json/"],
+            "names a folder",
+        ),
+    ] {
+        let out = merge_sim(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+    }
+    assert_eq!(std::fs::read_to_string(&scenario).unwrap(), urgent());
+    assert_eq!(std::fs::read_to_string(&shard).unwrap(), shard_text);
+    assert!(!same.exists());
+}
+
+#[test]
+fn plot_files_that_are_not_ours_are_refused_before_simulating() {
+    let dir = scratch("robust_plots");
+    let plots = dir.join("plots");
+    std::fs::create_dir_all(plots.join("states_ego.png")).unwrap();
+    let started = Instant::now();
+    let out = merge_sim(&["compare", "--planners", "pf-cs", "--plots", p(&plots)]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("states_ego.png"), "{}", stderr(&out));
+    assert!(started.elapsed() < Duration::from_secs(5));
+    assert_eq!(files_in(&plots), ["states_ego.png"]);
+}
+
+#[test]
+fn errors_about_names_presets_profiles_and_counts_carry_their_line() {
+    let dir = scratch("robust_lines");
+    let prescribed = urgent().replacen(
+        "driver = { planner = \"pf-iso\" }",
+        "driver = { prescribed = { path_planner = \"pf-cs\", speed_profile = [[0.0, 15.0, 3.0]] } }",
+        1,
+    );
+    let many = {
+        let mut text = urgent()
+            .replace("end_x_m = 700.0", "end_x_m = 9000.0")
+            .replace("duration_s = 25.0", "duration_s = 1.0");
+        let cut = text.find("[randomise]").unwrap();
+        text.truncate(cut);
+        for i in 0..199 {
+            text.push_str(&format!(
+                "[[vehicles]]\nname = \"v{i}\"\npreset = \"bmw_320i\"\nlane = \"upper\"\n\
+                 x_m = {}\nspeed_mps = 10.0\ntarget_speed_mps = 10.0\ndriver = \"idm\"\n\n",
+                100.0 + 10.0 * i as f64
+            ));
+        }
+        text
+    };
+    for (name, text, line_of, needle) in [
+        (
+            "duplicate.toml",
+            urgent().replacen("name = \"obstacle\"", "name = \"ego\"", 1),
+            "name = \"ego\"",
+            "duplicate vehicle name",
+        ),
+        (
+            "preset.toml",
+            urgent().replacen("preset = \"bmw_320i\"", "preset = \"tesla\"", 1),
+            "preset = \"tesla\"",
+            "tesla",
+        ),
+        (
+            "profile.toml",
+            prescribed,
+            "speed_profile",
+            "exactly two numbers",
+        ),
+        // The header of the 201st vehicle (the last one).
+        ("many.toml", many, "[[vehicles]]", "1 to 200 vehicles"),
+        (
+            "step.toml",
+            urgent().replace("dt_s = 0.002", "dt_s = 0.02"),
+            "dt_s = 0.02",
+            "dt_s",
+        ),
+    ] {
+        let path = write(&dir, name, &text);
+        let out = merge_sim(&["run", "--no-rrd", "--scenario", p(&path)]);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(needle), "{name}: {err}");
+        // The last line holding `line_of` (the duplicate is the second `name = "ego"`).
+        let line = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| l.contains(line_of))
+            .map(|(i, _)| i + 1)
+            .last()
+            .unwrap();
+        assert!(
+            err.contains(&format!("line {line}")),
+            "{name}: line {line}? {err}"
+        );
+    }
+}

@@ -24,7 +24,27 @@ pub const MAX_PROFILE_POINTS: usize = 10_000;
 #[serde(transparent)]
 pub struct SpeedProfile {
     /// `[t_s, speed_mps]` points.
+    #[serde(deserialize_with = "points_of_two")]
     pub points: Vec<[f64; 2]>,
+}
+
+/// Reads `[[t_s, speed_mps], …]`: exactly two numbers per point (serde's arrays would
+/// silently ignore a third).
+fn points_of_two<'de, D: serde::Deserializer<'de>>(
+    deserializer: D,
+) -> Result<Vec<[f64; 2]>, D::Error> {
+    let points = Vec::<Vec<f64>>::deserialize(deserializer)?;
+    points
+        .into_iter()
+        .enumerate()
+        .map(|(i, point)| match point.as_slice() {
+            [t_s, speed_mps] => Ok([*t_s, *speed_mps]),
+            _ => Err(serde::de::Error::custom(format!(
+                "speed_profile point {i}: expected exactly two numbers [t_s, speed_mps], got {}",
+                point.len()
+            ))),
+        })
+        .collect()
 }
 
 impl SpeedProfile {

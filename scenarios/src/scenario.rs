@@ -79,7 +79,7 @@ pub enum ScenarioError {
         builtins: String,
     },
     /// The file could not be read.
-    #[error("cannot read scenario file {path}: {source}")]
+    #[error("cannot read scenario file {path}")]
     Io {
         /// The file.
         path: PathBuf,
@@ -112,6 +112,9 @@ pub enum ScenarioError {
 /// enough for the run (the trackers hold speeds within a few per cent of their targets).
 pub const ROAD_END_SPEED_ALLOWANCE: f64 = 0.1;
 
+/// Longest scenario file read (bytes): 16 MiB, far beyond 200 vehicles with comments.
+pub const MAX_SCENARIO_BYTES: u64 = 16 << 20;
+
 impl Scenario {
     /// Loads a built-in by name, or else a TOML file by path.
     pub fn load(name_or_path: &str) -> Result<Self, ScenarioError> {
@@ -125,10 +128,12 @@ impl Scenario {
                 builtins: builtin::names().join(", "),
             });
         }
-        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = mergesim_types::files::read_regular_text(path, MAX_SCENARIO_BYTES).map_err(
+            |source| ScenarioError::Io {
+                path: path.to_path_buf(),
+                source,
+            },
+        )?;
         Self::from_toml(&text, &path.display().to_string())
     }
 
@@ -303,11 +308,16 @@ impl Scenario {
             } else if y[0] < lower_edge_m || y[1] > road.y_upper_m() {
                 Some(format!(
                     "its body spans y = [{:.3}, {:.3}] m, beyond the road's edges [{:.3}, {:.3}] m \
-                     there",
+                     there{}",
                     y[0],
                     y[1],
                     lower_edge_m,
-                    road.y_upper_m()
+                    road.y_upper_m(),
+                    if lower_edge_m > road.y_bottom_m + 1e-9 {
+                        " (the lower lane narrows in the merge section: start it further back)"
+                    } else {
+                        ""
+                    }
                 ))
             } else {
                 None
@@ -317,7 +327,10 @@ impl Scenario {
                     .randomise
                     .vehicle_entry_path(&v.name, "y_offset_m")
                     .or_else(|| self.nominal_path(&format!("vehicles[{}].y_offset_m", v.name)));
-                let lateral = why.starts_with("its body spans y");
+                // Off the side where the lower edge tapers: the position along the road is the
+                // cause, not the lateral offset.
+                let in_taper = lower_edge_m > road.y_bottom_m + 1e-9;
+                let lateral = why.starts_with("its body spans y") && !in_taper;
                 let field = format!(
                     "vehicles[{}].{}",
                     v.name,
@@ -394,9 +407,26 @@ impl Scenario {
     /// The TOML path of a nominal field named as the simulator names it (`mu`,
     /// `v2v.latency_s`, `vehicles[ego].x_m`).
     fn nominal_path(&self, field: &str) -> Option<Vec<String>> {
+        if field == "vehicles" {
+            // Too many vehicles: the first one beyond the limit.
+            return Some(vec![
+                "vehicles".into(),
+                sim::config::MAX_VEHICLES.to_string(),
+            ]);
+        }
         if let Some((name, key)) = split_vehicle_field(field) {
-            let index = self.vehicles.iter().position(|v| v.name == name)?;
-            return Some(vec!["vehicles".into(), index.to_string(), key.to_string()]);
+            // `vehicles[#i]` names the i-th vehicle; a nested key (`driver.prescribed…`) is
+            // found at its first component.
+            let index = match name.strip_prefix('#') {
+                Some(i) => i.parse().ok()?,
+                None => self.vehicles.iter().position(|v| v.name == name)?,
+            };
+            let first = key.split(['.', '[', ' ']).next().unwrap_or(key);
+            return Some(vec![
+                "vehicles".into(),
+                index.to_string(),
+                first.to_string(),
+            ]);
         }
         let mut path = vec!["sim".to_string()];
         path.extend(field.split('.').map(str::to_string));
@@ -459,7 +489,7 @@ impl Scenario {
 
 /// The field a simulator error names, if any.
 fn sim_error_field(e: &SimError) -> Option<String> {
-    e.invalid_parameter().map(|p| p.name.clone())
+    e.field()
 }
 
 /// `vehicles[NAME].key` → (`NAME`, `key`).

@@ -116,19 +116,44 @@ impl SimConfig {
                 ("safety_period_s", self.safety_period_s),
             ],
         )?;
-        for (name, value) in [
-            ("duration_s", self.duration_s),
-            ("planner_period_s", self.planner_period_s),
-            ("log_period_s", self.log_period_s),
-            ("field_log_period_s", self.field_log_period_s),
-            ("safety_period_s", self.safety_period_s),
+        let defaults = SimConfig::default();
+        for (name, value, default) in [
+            ("duration_s", self.duration_s, defaults.duration_s),
+            (
+                "planner_period_s",
+                self.planner_period_s,
+                defaults.planner_period_s,
+            ),
+            ("log_period_s", self.log_period_s, defaults.log_period_s),
+            (
+                "field_log_period_s",
+                self.field_log_period_s,
+                defaults.field_log_period_s,
+            ),
+            (
+                "safety_period_s",
+                self.safety_period_s,
+                defaults.safety_period_s,
+            ),
         ] {
             if value < self.dt_s {
-                return Err(SimError::invalid(
-                    name,
-                    value,
-                    format!("must be at least one physics step, dt_s = {} s", self.dt_s),
-                ));
+                // A period left at its default is not what the user changed: name dt_s.
+                return Err(if value == default {
+                    SimError::invalid(
+                        "dt_s",
+                        self.dt_s,
+                        format!(
+                            "the physics step must not exceed {name} = {value} s (its default); \
+                             shorten dt_s or set {name}"
+                        ),
+                    )
+                } else {
+                    SimError::invalid(
+                        name,
+                        value,
+                        format!("must be at least one physics step, dt_s = {} s", self.dt_s),
+                    )
+                });
             }
         }
         self.v2v.validate()?;
@@ -245,18 +270,24 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
     }
     for (i, spec) in specs.iter().enumerate() {
         if specs[..i].iter().any(|other| other.name == spec.name) {
-            return Err(SimError::InvalidScenario(format!(
-                "duplicate vehicle name {:?}",
-                spec.name
-            )));
+            return Err(SimError::InvalidField {
+                field: format!("vehicles[#{i}].name"),
+                message: format!("duplicate vehicle name {:?}", spec.name),
+            });
         }
         if spec.name.is_empty() || spec.name.contains([',', '"', '\n']) {
-            return Err(SimError::InvalidScenario(format!(
-                "vehicle name {:?} must be non-empty and free of commas, quotes and newlines",
-                spec.name
-            )));
+            return Err(SimError::InvalidField {
+                field: format!("vehicles[#{i}].name"),
+                message: format!(
+                    "vehicle name {:?} must be non-empty and free of commas, quotes and newlines",
+                    spec.name
+                ),
+            });
         }
-        vehicles::VehicleParams::preset(&spec.preset)?;
+        vehicles::VehicleParams::preset(&spec.preset).map_err(|e| SimError::InvalidField {
+            field: format!("vehicles[{}].preset", spec.name),
+            message: e.to_string(),
+        })?;
         let field = |name: &str| format!("vehicles[{}].{name}", spec.name);
         if let Driver::Prescribed { speed_profile, .. } = &spec.driver {
             speed_profile.validate(&field("driver.prescribed"))?;

@@ -10,6 +10,16 @@ pub enum SimError {
     /// A parameter is out of range (its dotted name, e.g. `v2v.drop_probability`, says which).
     #[error(transparent)]
     InvalidParameter(#[from] InvalidParameter),
+    /// A field that is not a number is wrong (its dotted name says which, e.g.
+    /// `vehicles[ego].preset`).
+    #[error("{field}: {message}")]
+    InvalidField {
+        /// Dotted name; `vehicles[#i]` names the i-th vehicle (0-based) when its name is the
+        /// problem.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
     /// Something about the scenario's vehicles is inconsistent (duplicate ids, ...).
     #[error("invalid scenario: {0}")]
     InvalidScenario(String),
@@ -79,6 +89,15 @@ impl SimError {
     /// Shorthand for [`SimError::InvalidParameter`].
     pub fn invalid(name: impl Into<String>, value: f64, reason: impl Into<String>) -> Self {
         Self::InvalidParameter(InvalidParameter::new(name, value, reason))
+    }
+
+    /// The dotted name of the field it is about, if any (numeric or not).
+    pub fn field(&self) -> Option<String> {
+        match self {
+            Self::InvalidField { field, .. } => Some(field.clone()),
+            Self::UnknownPlanner { vehicle, .. } => Some(format!("vehicles[{vehicle}].driver")),
+            other => other.invalid_parameter().map(|p| p.name.clone()),
+        }
     }
 
     /// The parameter it names, if it is about one (also inside a vehicle's or a planner's

@@ -85,6 +85,16 @@ impl IdmParams {
                 ("corridor_half_width_m", self.corridor_half_width_m),
             ],
         )?;
+        if self.comfortable_decel_mps2 > self.max_decel_mps2 {
+            return Err(SimError::invalid(
+                "idm.comfortable_decel_mps2",
+                self.comfortable_decel_mps2,
+                format!(
+                    "must not exceed idm.max_decel_mps2 = {} m/s²",
+                    self.max_decel_mps2
+                ),
+            ));
+        }
         Ok(())
     }
 }

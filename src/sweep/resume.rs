@@ -23,9 +23,11 @@ pub fn read_jsonl(
     text: &str,
     origin: &str,
     identity: &SweepIdentity,
+    instances: std::ops::Range<u64>,
 ) -> Result<ResumedRows, SweepError> {
     let complete_len = text.rfind('\n').map_or(0, |i| i + 1);
     let mut runs = Vec::new();
+    let mut seen = std::collections::BTreeMap::new();
     for (index, line) in text[..complete_len].lines().enumerate() {
         let number = index + 1;
         if line.trim().is_empty() {
@@ -38,12 +40,12 @@ pub fn read_jsonl(
         })?;
         let fields = [
             ("scenario", &identity.scenario, &record.scenario),
+            ("params", &identity.params, &record.params),
             (
                 "scenario_fingerprint",
                 &identity.scenario_fingerprint,
                 &record.scenario_fingerprint,
             ),
-            ("params", &identity.params, &record.params),
             ("planner", &identity.planner, &record.planner),
             (
                 "sweep_seed",
@@ -64,6 +66,27 @@ pub fn read_jsonl(
                      scenario, parameters, planner, --runs and --seed)"
                 )));
             }
+        }
+        let instance = record.row.instance;
+        if !instances.contains(&instance) {
+            return Err(SweepError::Invalid(format!(
+                "{origin}, line {number}: instance {instance} lies outside this shard's \
+                 instances {}..{} (resume with the same --shard)",
+                instances.start, instances.end
+            )));
+        }
+        let expected = super::instance_seed(identity.seed, instance);
+        if record.row.seed != expected {
+            return Err(SweepError::Invalid(format!(
+                "{origin}, line {number}: instance {instance} has seed {}, not {expected}: not \
+                 a row of this sweep",
+                record.row.seed
+            )));
+        }
+        if let Some(first) = seen.insert(instance, number) {
+            return Err(SweepError::Invalid(format!(
+                "{origin}, line {number}: instance {instance} appears twice (also line {first})"
+            )));
         }
         runs.push(FinishedRun {
             row: record.row,

@@ -9,6 +9,7 @@
 pub mod behaviour;
 pub mod bounds;
 pub mod error;
+pub mod files;
 pub mod grid;
 pub mod path;
 pub mod road;

@@ -1,11 +1,12 @@
 //! The subcommands: each parses nothing and prints or writes what the library returns.
 
 use std::io::{IsTerminal, Seek, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow};
-use mergesim::output::{check_output_path, write_atomically};
+use mergesim::output::{check_distinct, check_output_path, write_atomically};
 use mergesim::report::{comparison_table, grid_table, study_table, time_series_csv};
+use mergesim_types::files::read_regular_text;
 use scenarios::Scenario;
 use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
 
@@ -18,6 +19,32 @@ use crate::{
     Failure, Simulation, input, interrupted, load_scenario, out, outln, run_failure, simulate,
     sweep_failure, write_output,
 };
+
+/// Checks every output (path, option) before any work: each a writable regular file or new
+/// (`check_output_path`), no two the same file, none of them one of `inputs`.
+fn check_outputs(outputs: &[(Option<&Path>, &str)], inputs: &[&Path]) -> Result<(), Failure> {
+    let given: Vec<(&Path, &str)> = outputs
+        .iter()
+        .filter_map(|(path, what)| path.map(|p| (p, *what)))
+        .collect();
+    for (path, what) in &given {
+        check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
+    }
+    check_distinct(&given, inputs).map_err(|e| input(anyhow!(e)))
+}
+
+/// The scenario file read by `--scenario` (none for a built-in).
+fn scenario_file(name_or_path: &str) -> Vec<&Path> {
+    if scenarios::builtin::toml_of(name_or_path).is_some() {
+        Vec::new()
+    } else {
+        vec![Path::new(name_or_path)]
+    }
+}
+
+/// Longest sweep result file read back (`--resume`, `merge-results`): 4 GiB, beyond the rows
+/// of `sweep::MAX_RUNS` runs.
+const MAX_RESULT_FILE_BYTES: u64 = 4 << 30;
 
 /// Recordings estimated above this size are announced before they are written.
 const RECORDING_WARNING_BYTES: f64 = 500e6;
@@ -37,15 +64,14 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
             ))
         }))
     };
-    for (path, what) in [
-        (rrd.as_deref(), "--rrd"),
-        (args.json.as_deref(), "--json"),
-        (args.csv.as_deref(), "--csv"),
-    ] {
-        if let Some(path) = path {
-            check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
-        }
-    }
+    check_outputs(
+        &[
+            (rrd.as_deref(), "--rrd"),
+            (args.json.as_deref(), "--json"),
+            (args.csv.as_deref(), "--csv"),
+        ],
+        &scenario_file(&args.source.scenario),
+    )?;
     if let Some(path) = &rrd {
         let instance = scenario.instance(args.seed);
         let bytes = sim::recording::size_estimate::estimated_bytes(
@@ -120,11 +146,13 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
 
 pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(), Failure> {
     let scenario = load_scenario(&args.source.scenario, args.source.params)?;
-    if let Some(path) = &args.json {
-        check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
-    }
+    check_outputs(
+        &[(args.json.as_deref(), "--json")],
+        &scenario_file(&args.source.scenario),
+    )?;
     if let Some(dir) = &args.plots {
-        mergesim::plots::check_plot_dir(dir).map_err(|e| input(anyhow!(e)))?;
+        let vehicles: Vec<&str> = scenario.vehicles.iter().map(|v| v.name.as_str()).collect();
+        mergesim::plots::check_plot_dir(dir, &vehicles).map_err(|e| input(anyhow!(e)))?;
     }
     let show_progress = std::io::stderr().is_terminal();
     let mut summaries = Vec::new();
@@ -228,9 +256,15 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
         Shard, SweepIdentity, SweepOptions, SweepPlan, resume::read_jsonl, run_sweep, validate,
     };
     let scenario = load_scenario(&args.source.scenario, args.source.params)?;
-    if let Some(path) = &args.json {
-        check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
-    }
+    // An existing JSONL passes (a regular file): --resume reads it back, else it is refused
+    // below.
+    check_outputs(
+        &[
+            (args.json.as_deref(), "--json"),
+            (args.jsonl.as_deref(), "--jsonl"),
+        ],
+        &scenario_file(&args.source.scenario),
+    )?;
     let shard = match args.shard {
         Some(shard) => shard,
         None => Shard::from_environment(|name| std::env::var(name).ok())
@@ -260,11 +294,16 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
             }
             if exists {
                 check_output_path(path, "--jsonl").map_err(|e| input(anyhow!(e)))?;
-                let text = std::fs::read_to_string(path)
+                let text = read_regular_text(path, MAX_RESULT_FILE_BYTES)
                     .with_context(|| format!("cannot read {}", path.display()))
                     .map_err(input)?;
-                let read = read_jsonl(&text, &path.display().to_string(), &identity)
-                    .map_err(sweep_failure)?;
+                let read = read_jsonl(
+                    &text,
+                    &path.display().to_string(),
+                    &identity,
+                    shard.instances(args.runs),
+                )
+                .map_err(sweep_failure)?;
                 if read.torn_last_line && !args.quiet {
                     eprintln!(
                         "warning: {}: the last line was cut short (the process was killed while \
@@ -464,13 +503,12 @@ fn open_jsonl(
 
 pub(crate) fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> {
     use mergesim::sweep::{SweepSummary, merge_shards};
-    if let Some(path) = &args.json {
-        check_output_path(path, "--json").map_err(|e| input(anyhow!(e)))?;
-    }
+    let inputs: Vec<&Path> = args.inputs.iter().map(PathBuf::as_path).collect();
+    check_outputs(&[(args.json.as_deref(), "--json")], &inputs)?;
     let mut parts = Vec::with_capacity(args.inputs.len());
     for path in &args.inputs {
         let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path)
+        let text = read_regular_text(path, MAX_RESULT_FILE_BYTES)
             .with_context(|| format!("cannot read {origin}"))
             .map_err(input)?;
         let part: SweepSummary = serde_json::from_str(&text)
@@ -511,15 +549,14 @@ pub(crate) fn cmd_grid(args: &GridArgs, interrupt: &Interrupt) -> Result<(), Fai
             args.runs
         )));
     }
-    for (path, what) in [
-        (args.csv.as_deref(), "--csv"),
-        (args.json.as_deref(), "--json"),
-        (args.plot.as_deref(), "--plot"),
-    ] {
-        if let Some(path) = path {
-            check_output_path(path, what).map_err(|e| input(anyhow!(e)))?;
-        }
-    }
+    check_outputs(
+        &[
+            (args.csv.as_deref(), "--csv"),
+            (args.json.as_deref(), "--json"),
+            (args.plot.as_deref(), "--plot"),
+        ],
+        &scenario_file(&args.source.scenario),
+    )?;
     if args.plot.is_some() && args.planners.len() < 2 {
         return Err(input(anyhow!(
             "--plot: the figure compares planners with the first; give at least two"

@@ -1,6 +1,8 @@
-//! SIGINT / SIGTERM: the first asks the running command to stop cleanly (a sweep keeps every
-//! finished row and writes the aggregate of what finished; a run deletes its partial
-//! recording); a second one ends the process at once.
+//! SIGINT / SIGTERM ask the running command to stop cleanly: a sweep keeps every finished row
+//! and writes the aggregate of what finished, a run deletes its partial recording. The
+//! simulation checks the request before every physics step, so this takes milliseconds.
+//! Repeated signals change nothing (`timeout` and process-group signals deliver the same one
+//! twice); SIGKILL remains for a process that must die at once.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -17,13 +19,7 @@ impl Interrupt {
     pub(crate) fn install() -> Self {
         let flag = Arc::new(AtomicBool::new(false));
         let signal = Arc::new(AtomicUsize::new(0));
-        for (number, code) in [
-            (signal_hook::consts::SIGINT, 130),
-            (signal_hook::consts::SIGTERM, 143),
-        ] {
-            // Order matters: the conditional exit sees the flag as set only from the second
-            // signal on.
-            let _ = signal_hook::flag::register_conditional_shutdown(number, code, flag.clone());
+        for number in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
             let _ = signal_hook::flag::register_usize(number, signal.clone(), number as usize);
             let _ = signal_hook::flag::register(number, flag.clone());
         }
