@@ -55,6 +55,17 @@ pub fn other_limits() -> Vec<(String, String)> {
             format!("{merge_min_m} to {merge_max_m} m"),
         ),
         (
+            "`[sim.idm]` decelerations".into(),
+            "`comfortable_decel_mps2` ≤ `max_decel_mps2`".into(),
+        ),
+        (
+            "scenario file".into(),
+            format!(
+                "a regular file of at most {} MiB",
+                scenarios::scenario::MAX_SCENARIO_BYTES >> 20
+            ),
+        ),
+        (
             "`[sim.planner]` `waypoint_count`".into(),
             format!("whole number, {MIN_WAYPOINTS} to {MAX_WAYPOINTS}"),
         ),
