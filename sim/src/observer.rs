@@ -58,6 +58,13 @@ pub trait TickObserver {
         false
     }
 
+    /// Whether [`VehicleView::received`] should be filled for vehicle `id` (default: as
+    /// [`Self::wants_received_paths`]); lets an observer that shows only some vehicles spare
+    /// the look-ups of the others.
+    fn wants_received_paths_of(&self, _id: VehicleId) -> bool {
+        self.wants_received_paths()
+    }
+
     /// A vehicle has planned.
     fn on_plan(&mut self, _t_s: f64, _plan: &PlanView<'_, '_>) -> Result<(), SimError> {
         Ok(())

@@ -53,6 +53,10 @@ impl TickObserver for RecordingObserver {
         self.recorder.as_ref().is_some_and(Recorder::is_enabled)
     }
 
+    fn wants_received_paths_of(&self, id: mergesim_types::VehicleId) -> bool {
+        (id as usize) < self.detail_below && self.wants_received_paths()
+    }
+
     fn on_plan(&mut self, _t_s: f64, plan: &PlanView<'_, '_>) -> Result<(), SimError> {
         if !plan.field_due || plan.observation.ego_id as usize >= self.detail_below {
             return Ok(());

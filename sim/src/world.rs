@@ -389,8 +389,6 @@ impl World {
         for text in crossings {
             self.event(text, EventLevel::Info)?;
         }
-        let want_received = self.recording.wants_received_paths()
-            || self.observers.iter().any(|o| o.wants_received_paths());
         let samples: Vec<MetricsSample> = kins
             .iter()
             .map(|k| MetricsSample {
@@ -409,7 +407,12 @@ impl World {
             .agents
             .iter()
             .map(|a| {
-                if want_received && a.spec.connected {
+                let wanted = self.recording.wants_received_paths_of(a.id)
+                    || self
+                        .observers
+                        .iter()
+                        .any(|o| o.wants_received_paths_of(a.id));
+                if wanted && a.spec.connected {
                     self.bus.fresh_paths(a.id, t_s)
                 } else {
                     Vec::new()
