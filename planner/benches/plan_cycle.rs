@@ -5,9 +5,11 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use planner::{
-    MergeRoad, Neighbour, PfPlanner, PlanRequest, PlannerKind, PlannerParams, VehicleShape,
-    VehicleState,
+    MergeRoad, Neighbour, PfPlanner, PlanRequest, PlannerKind, PlannerParams, SharedLocalPath,
+    VehicleShape, VehicleState,
 };
+
+type SharedLocalPathVec = Vec<SharedLocalPath>;
 
 fn plan_cycle(c: &mut Criterion) {
     let road = MergeRoad::default();
@@ -88,6 +90,88 @@ fn plan_cycle(c: &mut Criterion) {
             )
             .expect("valid");
             fresh.plan(black_box(&request))
+        })
+    });
+    // The same encounter as it unfolds: both vehicles advance at their speeds, one planning
+    // period (0.1 s) per cycle, and the neighbour's shared path is re-planned each time (outside
+    // the timing), so every cycle warm-starts from the previous cycle's plan shifted in time as
+    // in the closed loop. A static request re-planned at the same instant converges onto its
+    // own optimum and flatters any warm start; this one does not.
+    let period_s = 0.1;
+    let cycles = 40;
+    let mut other_planner = PfPlanner::new(
+        PlannerKind::PfIso,
+        planner.params().clone(),
+        planner.road().clone(),
+    )
+    .expect("valid");
+    let moving: Vec<(f64, VehicleState, VehicleState, SharedLocalPathVec)> = (0..cycles)
+        .map(|k| {
+            let t_s = 8.0 + period_s * k as f64;
+            let dt_s = t_s - 8.0;
+            let ego_k = VehicleState {
+                x_m: ego.x_m + ego.speed_mps * dt_s,
+                ..ego
+            };
+            let other_k = VehicleState {
+                x_m: other.x_m + other.speed_mps * dt_s,
+                ..other
+            };
+            let shared = other_planner
+                .plan(&PlanRequest {
+                    time_s: t_s,
+                    ego_id: 1,
+                    ego: other_k,
+                    ego_shape: shape,
+                    target_speed_mps: 15.0,
+                    mu: 0.8,
+                    neighbours: &[Neighbour {
+                        id: 0,
+                        state: ego_k,
+                        shape,
+                    }],
+                    shared_paths: &[],
+                })
+                .expect("valid request")
+                .shared;
+            (t_s, ego_k, other_k, vec![shared])
+        })
+        .collect();
+    let mut moving_planner = PfPlanner::new(
+        PlannerKind::PfIso,
+        planner.params().clone(),
+        planner.road().clone(),
+    )
+    .expect("valid");
+    let mut next = 0;
+    c.bench_function("pf_iso_plan_cycle_n20_one_neighbour_moving", |b| {
+        b.iter(|| {
+            let (t_s, ego_k, other_k, shared) = &moving[next % cycles];
+            if next % cycles == 0 {
+                // Back to the start of the encounter: no plan from the future to warm-start.
+                moving_planner = PfPlanner::new(
+                    PlannerKind::PfIso,
+                    planner.params().clone(),
+                    planner.road().clone(),
+                )
+                .expect("valid");
+            }
+            next += 1;
+            let neighbours = [Neighbour {
+                id: 1,
+                state: *other_k,
+                shape,
+            }];
+            moving_planner.plan(black_box(&PlanRequest {
+                time_s: *t_s,
+                ego_id: 0,
+                ego: *ego_k,
+                ego_shape: shape,
+                target_speed_mps: 20.0,
+                mu: 0.8,
+                neighbours: &neighbours,
+                shared_paths: shared,
+            }))
         })
     });
     let mut sp = PfPlanner::new(

@@ -1,6 +1,7 @@
 //! Colours and names of the recording: the vehicles' palette, the field's viridis scale and its
 //! normalisation, entity-path parts, the yaw as a quaternion.
 
+#[cfg(feature = "rerun")]
 use rerun::datatypes::Quaternion;
 
 use super::FieldColorScale;
@@ -95,6 +96,7 @@ pub fn entity_part(name: &str) -> String {
     if part.is_empty() { "_".into() } else { part }
 }
 
+#[cfg(feature = "rerun")]
 pub(crate) fn yaw_quaternion(yaw_rad: f64) -> Quaternion {
     let half = 0.5 * yaw_rad;
     Quaternion::from_xyzw([0.0, 0.0, half.sin() as f32, half.cos() as f32])

@@ -8,7 +8,7 @@ use rerun::{Boxes3D, LineStrips3D, Mesh3D, Points3D, Scalars, SeriesLines, TextL
 use crate::body_state::BodyState;
 
 use super::colors::{entity_part, normalize_field, vehicle_color, viridis, yaw_quaternion};
-use super::{EventLevel, Recorder, RecordingError};
+use super::{EventLevel, Recorder, RecordingError, check_finite};
 
 impl Recorder {
     /// Logs the road (static): edges, lane divider and the merge section.
@@ -329,18 +329,4 @@ impl Recorder {
         )?;
         Ok(())
     }
-}
-
-pub(super) fn check_finite(
-    call: &'static str,
-    what: &str,
-    values: &[f64],
-) -> Result<(), RecordingError> {
-    if let Some(v) = values.iter().find(|v| !v.is_finite()) {
-        return Err(RecordingError::InvalidInput {
-            call,
-            reason: format!("{what} is not finite ({v})"),
-        });
-    }
-    Ok(())
 }

@@ -1,5 +1,9 @@
 //! Rerun recording of a run (`.rrd` file) with the `rerun` 0.36 Rust SDK.
 //!
+//! Built only with the cargo feature `rerun` (on by default); without it, which spares the
+//! Rerun SDK's ~500 crates, [`Recorder::disabled`] works as always and
+//! [`Recorder::new_file_with_params`] returns [`RecordingError::Unsupported`].
+//!
 //! A [`Recorder`] either writes a file or does nothing ([`Recorder::disabled`]), so the world
 //! loop can call it unconditionally. The file is written to `<path>.tmp` and renamed to `<path>`
 //! only by [`Recorder::finish`]; a recorder dropped without `finish` (a run that failed)
@@ -33,21 +37,23 @@
 //! the right. Disable it with [`RecorderParams::blueprint`].
 
 mod colors;
+#[cfg(feature = "rerun")]
 mod entities;
+#[cfg(feature = "rerun")]
+mod rerun_file;
 pub mod size_estimate;
+#[cfg(not(feature = "rerun"))]
+mod without_rerun;
 
-use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-use rerun::blueprint::{
-    Blueprint, ContainerLike, Horizontal, Spatial3DView, TextLogView, TimeSeriesView, Vertical,
-};
-use rerun::components::{Color, TextLogLevel};
-use rerun::{RecordingStream, RecordingStreamBuilder, ViewCoordinates};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use entities::check_finite;
+#[cfg(feature = "rerun")]
+use rerun_file::ActiveRecording;
+#[cfg(not(feature = "rerun"))]
+use without_rerun::ActiveRecording;
 
 /// Name of the timeline all temporal data is logged on.
 pub const SIM_TIMELINE: &str = "sim_time";
@@ -129,26 +135,23 @@ pub enum EventLevel {
     Error,
 }
 
-impl EventLevel {
-    fn as_text_log_level(self) -> TextLogLevel {
-        TextLogLevel::from(match self {
-            Self::Debug => TextLogLevel::DEBUG,
-            Self::Info => TextLogLevel::INFO,
-            Self::Warn => TextLogLevel::WARN,
-            Self::Error => TextLogLevel::ERROR,
-        })
-    }
-}
-
 /// Everything that can go wrong while recording. Never a panic.
 #[derive(Debug, Error)]
 pub enum RecordingError {
     /// The Rerun SDK could not create the stream or log data.
+    #[cfg(feature = "rerun")]
     #[error("rerun: {0}")]
     Rerun(#[from] rerun::RecordingStreamError),
     /// Flushing the stream to the file failed.
+    #[cfg(feature = "rerun")]
     #[error("rerun flush: {0}")]
     Flush(#[from] rerun::sink::SinkFlushError),
+    /// This build has no Rerun support (built without the cargo feature `rerun`).
+    #[error(
+        "this merge_sim was built without recording support (cargo feature `rerun`, on by \
+         default): run with --no-rrd, or rebuild with the default features"
+    )]
+    Unsupported,
     /// Renaming or removing the file failed.
     #[error("file {path}: {source}")]
     Io {
@@ -165,16 +168,6 @@ pub enum RecordingError {
         /// What is wrong.
         reason: String,
     },
-}
-
-struct ActiveRecording {
-    stream: RecordingStream,
-    tmp_path: PathBuf,
-    final_path: PathBuf,
-    /// Series entities whose static `SeriesLines` style has been logged.
-    styled_series: BTreeSet<String>,
-    /// Colour of each vehicle name seen in `log_vehicles`.
-    name_colors: BTreeMap<String, Color>,
 }
 
 /// Writes a Rerun recording, or does nothing when disabled.
@@ -198,74 +191,6 @@ impl Recorder {
         Self::new_file_with_params(path, app_id, RecorderParams::default())
     }
 
-    /// Starts a recording to `path` with `params`.
-    pub fn new_file_with_params(
-        path: impl AsRef<Path>,
-        app_id: &str,
-        params: RecorderParams,
-    ) -> Result<Self, RecordingError> {
-        let final_path = path.as_ref().to_path_buf();
-        let mut tmp_name = final_path.as_os_str().to_owned();
-        tmp_name.push(".tmp");
-        let tmp_path = PathBuf::from(tmp_name);
-
-        // `enabled(true)`: an explicit file recording is not switched off by the `RERUN`
-        // environment variable; use `Recorder::disabled` for that.
-        let app_id =
-            rerun::ApplicationId::try_new(app_id).map_err(|e| RecordingError::InvalidInput {
-                call: "new_file",
-                reason: e.to_string(),
-            })?;
-        let mut builder = RecordingStreamBuilder::new(app_id).enabled(true);
-        if params.blueprint {
-            builder = builder.with_default_blueprint(Self::blueprint(&params));
-        }
-        // A stale temporary file (or link) of a killed process is removed, never written
-        // through.
-        if std::fs::symlink_metadata(&tmp_path).is_ok() {
-            std::fs::remove_file(&tmp_path).ok();
-        }
-        let stream = builder.save(&tmp_path)?;
-        stream.log_static("world", &ViewCoordinates::RIGHT_HAND_Z_UP())?;
-        Ok(Self {
-            params,
-            active: Some(ActiveRecording {
-                stream,
-                tmp_path,
-                final_path,
-                styled_series: BTreeSet::new(),
-                name_colors: BTreeMap::new(),
-            }),
-        })
-    }
-
-    /// The default layout: road 3D view over the event log, time series on the right.
-    fn blueprint(params: &RecorderParams) -> Blueprint {
-        let plots: Vec<ContainerLike> = params
-            .blueprint_series
-            .iter()
-            .map(|series| {
-                TimeSeriesView::new(series.clone())
-                    .with_origin(format!("/plots/{}", entity_part(series)))
-                    .into()
-            })
-            .collect();
-        let left = Vertical::new([
-            Spatial3DView::new("Road").with_origin("/world").into(),
-            TextLogView::new("Events").with_origin("/events").into(),
-        ])
-        .with_row_shares([3.0, 1.0]);
-        let root = if plots.is_empty() {
-            Horizontal::new([left.into()])
-        } else {
-            Horizontal::new([left.into(), Vertical::new(plots).into()])
-                .with_column_shares([3.0, 2.0])
-        };
-        Blueprint::new(root)
-            .with_auto_views(false)
-            .with_auto_layout(false)
-    }
-
     /// The recording's parameters.
     pub fn params(&self) -> &RecorderParams {
         &self.params
@@ -275,62 +200,6 @@ impl Recorder {
     pub fn is_enabled(&self) -> bool {
         self.active.is_some()
     }
-
-    /// The temporary file being written, if enabled.
-    pub fn tmp_path(&self) -> Option<&Path> {
-        self.active.as_ref().map(|a| a.tmp_path.as_path())
-    }
-
-    /// Sets the current time of the `sim_time` timeline (s).
-    pub fn set_time(&self, t_s: f64) -> Result<(), RecordingError> {
-        let Some(active) = &self.active else {
-            return Ok(());
-        };
-        check_finite("set_time", "t_s", &[t_s])?;
-        active.stream.set_duration_secs(SIM_TIMELINE, t_s);
-        Ok(())
-    }
-
-    /// Flushes and closes the file, then renames `<path>.tmp` to `<path>`.
-    pub fn finish(mut self) -> Result<(), RecordingError> {
-        let Some(active) = self.active.take() else {
-            return Ok(());
-        };
-        let ActiveRecording {
-            stream,
-            tmp_path,
-            final_path,
-            ..
-        } = active;
-        let flushed = stream.flush_blocking();
-        // Replaces the file sink; its writer thread writes the footer and closes the file
-        // before this returns.
-        stream.finalize_deferred_sinks();
-        drop(stream);
-        if let Err(err) = flushed {
-            std::fs::remove_file(&tmp_path).ok();
-            return Err(err.into());
-        }
-        std::fs::rename(&tmp_path, &final_path).map_err(|source| {
-            std::fs::remove_file(&tmp_path).ok();
-            RecordingError::Io {
-                path: final_path.clone(),
-                source,
-            }
-        })
-    }
-}
-
-impl Drop for Recorder {
-    /// A recorder dropped without [`Recorder::finish`] belongs to a failed run: close the
-    /// stream and delete the temporary file.
-    fn drop(&mut self) {
-        if let Some(active) = self.active.take() {
-            active.stream.finalize_deferred_sinks();
-            drop(active.stream);
-            std::fs::remove_file(&active.tmp_path).ok();
-        }
-    }
 }
 
 impl std::fmt::Debug for Recorder {
@@ -339,6 +208,18 @@ impl std::fmt::Debug for Recorder {
             .field("tmp_path", &self.tmp_path())
             .finish_non_exhaustive()
     }
+}
+
+/// An error naming `call` if any of `values` is not finite.
+#[cfg(feature = "rerun")]
+fn check_finite(call: &'static str, what: &str, values: &[f64]) -> Result<(), RecordingError> {
+    if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+        return Err(RecordingError::InvalidInput {
+            call,
+            reason: format!("{what} is not finite ({v})"),
+        });
+    }
+    Ok(())
 }
 
 pub use colors::{entity_part, normalize_field, vehicle_color, viridis};

@@ -70,7 +70,8 @@ pub(crate) struct RunArgs {
     /// scenario runs.
     #[arg(long, value_name = "N")]
     pub(crate) seed: Option<u64>,
-    /// Where to write the Rerun recording [default: <scenario>_<planner>.rrd].
+    /// Where to write the Rerun recording [default: <scenario>_<planner>.rrd; none in a build
+    /// without the cargo feature `rerun`].
     #[arg(long, value_name = "PATH", conflicts_with = "no_rrd")]
     pub(crate) rrd: Option<PathBuf>,
     /// Do not write a Rerun recording.

@@ -53,7 +53,14 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
     use mergesim::output::file_name_part;
     let scenario = load_scenario(&args.source.scenario, args.source.params)?;
     let label = mergesim::sweep::planner_label(&scenario, args.planner);
-    let rrd = if args.no_rrd {
+    if !cfg!(feature = "rerun") && (args.rrd.is_some() || args.view) {
+        return Err(crate::input(anyhow::anyhow!(
+            "{}",
+            sim::recording::RecordingError::Unsupported
+        )));
+    }
+    // Without Rerun support a run records nothing unless asked to (and then refuses, above).
+    let rrd = if args.no_rrd || !cfg!(feature = "rerun") {
         None
     } else {
         Some(args.rrd.clone().unwrap_or_else(|| {
