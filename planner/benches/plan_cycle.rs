@@ -6,7 +6,7 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use planner::{
     MergeRoad, Neighbour, PfPlanner, PlanRequest, PlannerKind, PlannerParams, SharedLocalPath,
-    VehicleShape, VehicleState,
+    SpeedProgram, VehicleShape, VehicleState,
 };
 
 type SharedLocalPathVec = Vec<SharedLocalPath>;
@@ -137,43 +137,54 @@ fn plan_cycle(c: &mut Criterion) {
             (t_s, ego_k, other_k, vec![shared])
         })
         .collect();
-    let mut moving_planner = PfPlanner::new(
-        PlannerKind::PfIso,
-        planner.params().clone(),
-        planner.road().clone(),
-    )
-    .expect("valid");
-    let mut next = 0;
-    c.bench_function("pf_iso_plan_cycle_n20_one_neighbour_moving", |b| {
-        b.iter(|| {
-            let (t_s, ego_k, other_k, shared) = &moving[next % cycles];
-            if next % cycles == 0 {
-                // Back to the start of the encounter: no plan from the future to warm-start.
-                moving_planner = PfPlanner::new(
-                    PlannerKind::PfIso,
-                    planner.params().clone(),
-                    planner.road().clone(),
-                )
-                .expect("valid");
-            }
-            next += 1;
-            let neighbours = [Neighbour {
-                id: 1,
-                state: *other_k,
-                shape,
-            }];
-            moving_planner.plan(black_box(&PlanRequest {
-                time_s: *t_s,
-                ego_id: 0,
-                ego: *ego_k,
-                ego_shape: shape,
-                target_speed_mps: 20.0,
-                mu: 0.8,
-                neighbours: &neighbours,
-                shared_paths: shared,
-            }))
-        })
-    });
+    // The same with the Newton QP as the convex subproblem (`speed_program = "newton-qp"`).
+    let newton_qp = PlannerParams {
+        speed_program: SpeedProgram::NewtonQp,
+        ..planner.params().clone()
+    };
+    for (name, params) in [
+        (
+            "pf_iso_plan_cycle_n20_one_neighbour_moving",
+            planner.params().clone(),
+        ),
+        (
+            "pf_iso_plan_cycle_n20_one_neighbour_moving_newton_qp",
+            newton_qp,
+        ),
+    ] {
+        let fresh = || {
+            PfPlanner::new(PlannerKind::PfIso, params.clone(), planner.road().clone())
+                .expect("valid")
+        };
+        let mut moving_planner = fresh();
+        let mut next = 0;
+        c.bench_function(name, |b| {
+            b.iter(|| {
+                let (t_s, ego_k, other_k, shared) = &moving[next % cycles];
+                if next % cycles == 0 {
+                    // Back to the start of the encounter: no plan from the future to
+                    // warm-start.
+                    moving_planner = fresh();
+                }
+                next += 1;
+                let neighbours = [Neighbour {
+                    id: 1,
+                    state: *other_k,
+                    shape,
+                }];
+                moving_planner.plan(black_box(&PlanRequest {
+                    time_s: *t_s,
+                    ego_id: 0,
+                    ego: *ego_k,
+                    ego_shape: shape,
+                    target_speed_mps: 20.0,
+                    mu: 0.8,
+                    neighbours: &neighbours,
+                    shared_paths: shared,
+                }))
+            })
+        });
+    }
     let mut sp = PfPlanner::new(
         PlannerKind::PfSp,
         planner.params().clone(),

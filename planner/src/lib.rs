@@ -38,6 +38,7 @@ pub use params::{PlannerParams, SlpReading};
 pub use planners::{PfPlanner, PlanRequest, PlanStats, PlannerKind};
 pub use potential_field::{GridSpec, PotentialField};
 pub use road::{Lane, MergeRoad};
+pub use speed_optimisation::SpeedProgram;
 pub use speed_profile::SpeedProfile;
 pub use types::*;
 

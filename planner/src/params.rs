@@ -14,6 +14,7 @@ use crate::error::PlannerError;
 use crate::following::V2vLossFallback;
 use crate::obstacle_field::{HeadingForm, MinDistanceLength, ObstacleFieldParams};
 use crate::prediction::PredictionModel;
+use crate::speed_optimisation::SpeedProgram;
 
 /// Smallest number of waypoints: a cubic has four coefficients (paper, after Eq. 9).
 pub const MIN_WAYPOINTS: usize = 4;
@@ -206,6 +207,10 @@ pub struct PlannerParams {
     pub solver_max_iterations: u32,
     /// Clarabel's gap and feasibility tolerances.
     pub solver_tolerance: f64,
+    /// How each SCP iteration's convex subproblem is posed: `cone` (the travel time exact, one
+    /// second-order cone per segment) or `newton-qp` (its second-order model: a QP, cheaper per
+    /// solve). See `speed_optimisation::SpeedProgram`.
+    pub speed_program: SpeedProgram,
     /// A shared local path older than this is ignored in favour of a prediction (s).
     pub max_shared_path_age_s: f64,
     /// How a vehicle without a fresh shared path is predicted: `constant-velocity` (straight
@@ -312,6 +317,7 @@ impl Default for PlannerParams {
             max_jerk_mps3: 10.0,
             solver_max_iterations: 50,
             solver_tolerance: 1e-7,
+            speed_program: SpeedProgram::NewtonQp,
             max_shared_path_age_s: 0.5,
             prediction: PredictionModel::LaneFollowing,
             // Twice the smallest weight with which the risk term keeps a PF-SP follower behind

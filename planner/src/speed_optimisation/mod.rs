@@ -2,7 +2,8 @@
 //! (SCP) with Clarabel.
 //!
 //! Files: [`scp`] (the SCP loop and its line search), [`cone_program`] (the convex
-//! subproblem: decision vector, constraint rows and their assembly), [`interaction_term`]
+//! subproblem: decision vector, constraint rows and their assembly), [`newton_qp`] (the same
+//! subproblem with the travel time's second-order model: a QP, `speed_program = "newton-qp"`), [`interaction_term`]
 //! (U_SLP at the planned arc length, and PF-SP's risk term), [`fixed_waypoint_term`] (U_SLP as
 //! the paper prints it), [`friction_limits`] (Eq. 10a).
 //!
@@ -36,8 +37,12 @@
 //!
 //! # Solution
 //!
-//! The travel time is convex: t_i ≥ Δs_i / v_i ⇔ t_i v_i ≥ Δs_i, t_i, v_i ≥ 0
-//! ⇔ ‖(t_i − v_i, 2√Δs_i)‖ ≤ t_i + v_i, a second-order cone. The interaction term is
+//! Each SCP iteration solves a convex subproblem, posed one of two ways
+//! (`PlannerParams::speed_program`): [`SpeedProgram::NewtonQp`] (default) replaces the travel
+//! time by its second-order Taylor model at the iterate, a QP ([`newton_qp`]);
+//! [`SpeedProgram::Cone`] keeps it exact: t_i ≥ Δs_i / v_i ⇔ t_i v_i ≥ Δs_i, t_i, v_i ≥ 0
+//! ⇔ ‖(t_i − v_i, 2√Δs_i)‖ ≤ t_i + v_i, a second-order cone ([`cone_program`]). What follows
+//! is written for the cone program; the QP differs only where said. The interaction term is
 //! linearised at the current iterate v̄ (φ ≈ φ(v̄) + ∇φ(v̄)ᵀ(v − v̄)), the resulting convex
 //! cone program is solved inside the trust region |v_i − v̄_i| ≤ ρ, and the step d = v* − v̄
 //! to its solution v* is shortened by a backtracking line search on the true J (t = 1, ½, ¼, …
@@ -48,15 +53,17 @@
 //! minimum lies between v̄ and v̄ ± ρ/2 successive planning cycles (each one warm-started at
 //! the last) jumped across it and back: a cycle-to-cycle sawtooth of ±ρ/4 in the planned
 //! speed. d is a descent direction whenever the convex model falls (the model's convex
-//! part is exact and its linear part is the gradient), so the search always finds a decrease
+//! part is exact — for the QP, exact to second order at v̄ — and its linear part is the
+//! gradient), so the search always finds a decrease
 //! unless v̄ is stationary, and v̄ + t d stays feasible (convex feasible set). It costs
 //! evaluations of J only, no extra solves. The start v̄⁰ is `initial_guess` (the previous plan
 //! shifted in time: across planning cycles this continues the same SCP, as in real-time
 //! iteration schemes) projected onto the box and acceleration chain, so every accepted
 //! iterate is feasible and J never exceeds J(v̄⁰). With jerk rows the projection may be
-//! infeasible and the first iteration runs without a trust region. With w3 = 0 (PF-SP) the
-//! problem is convex and one solve is exact. All iterations, and consecutive planning
-//! cycles, reuse one Clarabel solver through `update_q` / `update_b` (P and A are fixed).
+//! infeasible and the first iteration runs without a trust region. With w3 = 0 (PF-SP-EQ10)
+//! the problem is convex and one solve of the cone program is exact (the QP iterates). All
+//! iterations, and consecutive planning cycles, reuse one Clarabel solver through `update_q` /
+//! `update_b` (and, for the QP, `update_P` of its diagonal): A is fixed.
 //!
 //! The non-convex term is any [`SpeedTerm`]: w3·Σ φ_i of PF-ISO (either reading of U_SLP), or
 //! w_R·Σ U_i of PF-SP's risk-aware speeds, with its own weight in [`SpeedProblem`].
@@ -65,6 +72,7 @@ pub mod cone_program;
 pub mod fixed_waypoint_term;
 pub mod friction_limits;
 pub mod interaction_term;
+pub mod newton_qp;
 pub mod scp;
 
 pub use fixed_waypoint_term::FixedWaypointTerm;
@@ -72,7 +80,24 @@ pub use friction_limits::friction_speed_limits;
 pub use interaction_term::{Aggregate, InteractionTerm};
 pub use scp::SpeedOptimiser;
 
+use serde::{Deserialize, Serialize};
+
 use crate::params::PlannerParams;
+
+/// How each SCP iteration's convex subproblem is posed (`PlannerParams::speed_program`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpeedProgram {
+    /// The travel time exactly, t_i v_i ≥ Δs_i as one second-order cone per segment
+    /// ([`cone_program`]): a convex problem (no interaction term) is solved exactly in one
+    /// solve.
+    #[default]
+    Cone,
+    /// The travel time by its second-order Taylor model at the iterate: a QP with no cones and
+    /// no t variables ([`newton_qp`]), cheaper per solve; the SCP then iterates on convex
+    /// problems too.
+    NewtonQp,
+}
 
 /// A smooth, possibly non-convex term Σ_i φ_i(v) of the speed objective, linearised by the SCP.
 pub trait SpeedTerm: std::fmt::Debug {

@@ -3,7 +3,8 @@
 //! `speed_optimisation`).
 
 use super::cone_program::{CachedSolver, Layout};
-use super::{SpeedProblem, SpeedSolution, objective, smooth_gradient};
+use super::newton_qp::CachedQp;
+use super::{SpeedProblem, SpeedProgram, SpeedSolution, objective, smooth_gradient};
 use crate::error::PlannerError;
 use crate::params::PlannerParams;
 
@@ -12,12 +13,14 @@ use crate::params::PlannerParams;
 #[derive(Default)]
 pub struct SpeedOptimiser {
     pub(super) cached: Option<CachedSolver>,
+    pub(super) cached_qp: Option<CachedQp>,
 }
 
 impl std::fmt::Debug for SpeedOptimiser {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SpeedOptimiser")
             .field("cached", &self.cached.as_ref().map(|c| c.layout))
+            .field("cached_qp", &self.cached_qp.is_some())
             .finish()
     }
 }
@@ -162,8 +165,8 @@ impl SpeedOptimiser {
             }
         };
 
-        // Without interaction the problem is convex: one exact solve.
-        if interaction.is_none() {
+        // Without interaction the problem is convex: one exact solve of the cone program.
+        if interaction.is_none() && params.speed_program == SpeedProgram::Cone {
             let zero = vec![0.0; n];
             let mut solves = 1;
             let v = match self.solve_convex(
@@ -231,9 +234,15 @@ impl SpeedOptimiser {
                 (base_lo.clone(), base_hi.clone())
             };
             solves += 1;
-            let candidate = match self.solve_convex(
-                params, layout, problem, &g, &lo_k, &hi_k, accel_step, jerk_step,
-            ) {
+            let solved = match params.speed_program {
+                SpeedProgram::Cone => self.solve_convex(
+                    params, layout, problem, &g, &lo_k, &hi_k, accel_step, jerk_step,
+                ),
+                SpeedProgram::NewtonQp => self.solve_newton_qp(
+                    params, layout, problem, &v, &g, &lo_k, &hi_k, accel_step, jerk_step,
+                ),
+            };
+            let candidate = match solved {
                 Ok(candidate) => candidate,
                 Err(e) if !solved_once => return Err(e),
                 Err(_) => break,
@@ -319,7 +328,17 @@ mod tests {
 
     #[test]
     fn without_interaction_matches_the_per_waypoint_closed_form() {
+        for program in [SpeedProgram::Cone, SpeedProgram::NewtonQp] {
+            closed_form_case(program);
+        }
+    }
+
+    /// The cone program in one solve; the Newton QP iterated to convergence.
+    fn closed_form_case(program: SpeedProgram) {
         let params = PlannerParams {
+            speed_program: program,
+            max_scp_iterations: 30,
+            scp_relative_tolerance: 0.0,
             travel_time_weight: 40.0,
             speed_deviation_weight: 0.8,
             solver_tolerance: 1e-10,
@@ -340,7 +359,9 @@ mod tests {
         };
         let mut optimiser = SpeedOptimiser::new();
         let solution = optimiser.solve(&params, &problem).unwrap();
-        assert_eq!(solution.solves, 1);
+        if program == SpeedProgram::Cone {
+            assert_eq!(solution.solves, 1);
+        }
         // Accuracy owed by the solver: J is w2-strongly convex in v, so a duality gap g bounds
         // ½ w2 ‖v − v*‖² ≤ g; Clarabel stops at g ≤ tol·(1 + |J|).
         let gap = params.solver_tolerance * (1.0 + solution.objective.abs());
@@ -353,7 +374,7 @@ mod tests {
             let expected = free.clamp(params.min_speed_mps, max_speeds_mps[i]);
             assert!(
                 (solution.speeds_mps[i] - expected).abs() < owed,
-                "i = {i}: {} vs {expected} (owed {owed})",
+                "{program:?}, i = {i}: {} vs {expected} (owed {owed})",
                 solution.speeds_mps[i]
             );
         }
