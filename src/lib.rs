@@ -14,6 +14,7 @@ pub mod limits;
 pub mod output;
 pub mod plots;
 pub mod report;
+pub mod scaling;
 pub mod summary;
 pub mod sweep;
 

@@ -22,7 +22,8 @@ pub struct RunSummary {
     pub wall_time_s: f64,
     /// Number of collision events (vehicle–vehicle and vehicle–road edge).
     pub collisions: usize,
-    /// Exact minimum distance between any two vehicle boxes (m); null with a single vehicle.
+    /// Exact minimum distance between any two vehicle boxes (m); null with a single vehicle
+    /// or when no two ever came within `[sim.safety] pair_range_m` (250 m).
     pub min_gap_m: Option<f64>,
     /// Minimum time to collision (s); null if no pair was ever closing within the horizon.
     pub min_ttc_s: Option<f64>,

@@ -9,6 +9,7 @@
 
 pub mod builtin;
 pub mod distribution;
+pub mod platoon;
 pub mod randomisation;
 pub mod scenario;
 pub mod source_location;

@@ -31,6 +31,9 @@ pub struct SimConfig {
     pub field_log_period_s: f64,
     /// Period of the parry safety checks (s); rounded to whole physics steps.
     pub safety_period_s: f64,
+    /// A vehicle's behaviour is given the others whose centres are within this distance (m):
+    /// the reach of its sensors. 250 m, a long-range automotive radar's (docs/parameters.md).
+    pub perception_range_m: f64,
     /// V2V bus.
     pub v2v: V2vParams,
     /// Planner parameters (every PF vehicle).
@@ -54,6 +57,7 @@ impl Default for SimConfig {
             log_period_s: 0.05,
             field_log_period_s: 0.5,
             safety_period_s: 0.01,
+            perception_range_m: DEFAULT_PERCEPTION_RANGE_M,
             v2v: V2vParams::default(),
             planner: PlannerParams::default(),
             tracker: TrackerParams::default(),
@@ -73,7 +77,12 @@ pub const SIM_BOUNDS: &[Bound] = &[
     Bound::closed("log_period_s", 1e-4, 10.0, "s"),
     Bound::closed("field_log_period_s", 1e-4, 10.0, "s"),
     Bound::closed("safety_period_s", 1e-4, 10.0, "s"),
+    Bound::closed("perception_range_m", 1.0, 1e5, "m"),
 ];
+
+/// Default of [`SimConfig::perception_range_m`]: long-range automotive radars reach 250 m
+/// (e.g. Bosch LRR4, Continental ARS 408); docs/parameters.md gives the criterion.
+pub const DEFAULT_PERCEPTION_RANGE_M: f64 = 250.0;
 
 /// Allowed ranges of a vehicle's own fields (`[[vehicles]]`); `x_m` must also lie on the road
 /// and the body must fit on it at spawn (checked by the scenario loader).
@@ -83,7 +92,7 @@ pub const VEHICLE_BOUNDS: &[Bound] = &[
     Bound::closed("target_speed_mps", 0.5, 60.0, "m/s"),
 ];
 
-/// Most vehicles a scenario may hold (every vehicle plans against every other).
+/// Most vehicles a scenario may hold.
 pub const MAX_VEHICLES: usize = 200;
 
 /// Most vehicle physics steps of one run (vehicles × duration_s / dt_s): at ≈ 2 µs per vehicle
@@ -114,6 +123,7 @@ impl SimConfig {
                 ("log_period_s", self.log_period_s),
                 ("field_log_period_s", self.field_log_period_s),
                 ("safety_period_s", self.safety_period_s),
+                ("perception_range_m", self.perception_range_m),
             ],
         )?;
         let defaults = SimConfig::default();

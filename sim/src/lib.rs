@@ -20,6 +20,7 @@ pub mod registry;
 pub mod rng;
 pub mod run_log;
 pub mod safety;
+pub mod spatial;
 pub mod v2v;
 pub mod world;
 

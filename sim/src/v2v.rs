@@ -8,6 +8,11 @@
 //! message never replaces a newer one. Drops come from one random stream and jitter and
 //! duplicates from another, both seeded by the run's seed, so enabling jitter or duplicates
 //! does not change which messages are dropped.
+//!
+//! A broadcast reaches only the connected vehicles whose centres are within `range_m` of the
+//! sender when it is sent (300 m, DSRC's range; docs/parameters.md); the world finds them with
+//! the X sweep of `crate::spatial`, so a round of broadcasts costs O(N log N + k), not O(N²).
+//! A receiver's inbox forgets paths once they are stale (they could never be used again).
 
 use std::collections::BTreeMap;
 
@@ -39,7 +44,14 @@ pub struct V2vParams {
     /// independent delay.
     #[serde(default)]
     pub duplicate_probability: f64,
+    /// Radio range (m): a broadcast reaches the connected vehicles whose centres are within it
+    /// at the time of sending. 300 m, DSRC's (docs/parameters.md).
+    pub range_m: f64,
 }
+
+/// Default of [`V2vParams::range_m`]: DSRC (IEEE 802.11p) reaches about 300 m (NHTSA, *V2V
+/// Communications: Readiness of V2V Technology for Application*, 2014).
+pub const DEFAULT_V2V_RANGE_M: f64 = 300.0;
 
 impl Default for V2vParams {
     fn default() -> Self {
@@ -50,6 +62,7 @@ impl Default for V2vParams {
             stale_after_s: 0.5,
             jitter_s: 0.0,
             duplicate_probability: 0.0,
+            range_m: DEFAULT_V2V_RANGE_M,
         }
     }
 }
@@ -62,6 +75,7 @@ pub const V2V_BOUNDS: &[Bound] = &[
     Bound::above("stale_after_s", 0.0, 60.0, "s"),
     Bound::closed("jitter_s", 0.0, 10.0, "s"),
     Bound::closed("duplicate_probability", 0.0, 1.0, ""),
+    Bound::closed("range_m", 1.0, 1e5, "m"),
 ];
 
 impl V2vParams {
@@ -77,6 +91,7 @@ impl V2vParams {
                 ("stale_after_s", self.stale_after_s),
                 ("jitter_s", self.jitter_s),
                 ("duplicate_probability", self.duplicate_probability),
+                ("range_m", self.range_m),
             ],
         )?;
         Ok(())
@@ -113,6 +128,8 @@ pub struct V2vBus {
     /// Jitter and duplicates (a stream of its own: see the module doc).
     fault_rng: SplitMix64,
     in_flight: Vec<InFlight>,
+    /// Earliest `deliver_at_s` in flight (+∞ when none): `deliver` returns at once before it.
+    next_due_s: f64,
     /// receiver → sender → newest delivered path.
     inbox: BTreeMap<VehicleId, BTreeMap<VehicleId, SharedLocalPath>>,
     last_broadcast_s: BTreeMap<VehicleId, f64>,
@@ -128,6 +145,7 @@ impl V2vBus {
             rng: SplitMix64::new(seed),
             fault_rng: SplitMix64::new(SplitMix64::derive(seed, 1)),
             in_flight: Vec::new(),
+            next_due_s: f64::INFINITY,
             inbox: BTreeMap::new(),
             last_broadcast_s: BTreeMap::new(),
             stats: V2vStats::default(),
@@ -190,8 +208,10 @@ impl V2vBus {
                 } else {
                     0.0
                 };
+                let deliver_at_s = t_s + self.params.latency_s + jitter_s;
+                self.next_due_s = self.next_due_s.min(deliver_at_s);
                 self.in_flight.push(InFlight {
-                    deliver_at_s: t_s + self.params.latency_s + jitter_s,
+                    deliver_at_s,
                     receiver,
                     message: message.clone(),
                 });
@@ -201,9 +221,14 @@ impl V2vBus {
         true
     }
 
-    /// Delivers every message whose delivery time has come (in send order).
+    /// Delivers every message whose delivery time has come (in send order). Costs nothing
+    /// until the earliest message in flight is due.
     pub fn deliver(&mut self, t_s: f64) {
+        if self.next_due_s > t_s + 1e-12 {
+            return;
+        }
         let mut kept = Vec::with_capacity(self.in_flight.len());
+        let mut next_due_s = f64::INFINITY;
         for item in self.in_flight.drain(..) {
             if item.deliver_at_s <= t_s + 1e-12 {
                 let slot = self.inbox.entry(item.receiver).or_default();
@@ -215,10 +240,23 @@ impl V2vBus {
                 }
                 self.stats.delivered += 1;
             } else {
+                next_due_s = next_due_s.min(item.deliver_at_s);
                 kept.push(item);
             }
         }
         self.in_flight = kept;
+        self.next_due_s = next_due_s;
+    }
+
+    /// Forgets the paths that are stale at `t_s`. Changes no result: time only advances, so a
+    /// stale path stays stale, and a message older than a forgotten one that arrives later is
+    /// stale as well ([`Self::fresh_paths`] never returns either). It keeps each inbox as small
+    /// as the set of senders heard recently, rather than every sender ever heard.
+    pub fn forget_stale(&mut self, t_s: f64) {
+        let stale_after_s = self.params.stale_after_s;
+        for by_sender in self.inbox.values_mut() {
+            by_sender.retain(|_, p| is_fresh(p.stamp_s, t_s, stale_after_s));
+        }
     }
 
     /// The fresh paths `receiver` holds at `t_s`, ordered by sender id.
@@ -228,12 +266,17 @@ impl V2vBus {
             .map(|by_sender| {
                 by_sender
                     .values()
-                    .filter(|p| t_s - p.stamp_s <= self.params.stale_after_s + 1e-12)
+                    .filter(|p| is_fresh(p.stamp_s, t_s, self.params.stale_after_s))
                     .cloned()
                     .collect()
             })
             .unwrap_or_default()
     }
+}
+
+/// Whether a path stamped `stamp_s` is fresh at `t_s` (not older than `stale_after_s`).
+fn is_fresh(stamp_s: f64, t_s: f64, stale_after_s: f64) -> bool {
+    t_s - stamp_s <= stale_after_s + 1e-12
 }
 
 #[cfg(test)]
@@ -387,5 +430,44 @@ mod tests {
             bus.stats().dropped
         };
         assert_eq!(run(0.0, 0.0), run(0.5, 0.5));
+    }
+
+    #[test]
+    fn forgetting_stale_paths_changes_nothing_a_receiver_sees() {
+        let params = V2vParams {
+            latency_s: 0.05,
+            jitter_s: 0.8,
+            duplicate_probability: 0.3,
+            drop_probability: 0.2,
+            stale_after_s: 0.3,
+            ..V2vParams::default()
+        };
+        let mut kept = V2vBus::new(params.clone(), 11).unwrap();
+        let mut pruned = V2vBus::new(params, 11).unwrap();
+        for k in 0..2000 {
+            let t_s = 0.01 * k as f64;
+            for bus in [&mut kept, &mut pruned] {
+                bus.deliver(t_s);
+                if k % 10 == 0 {
+                    for sender in 0..3 {
+                        bus.broadcast(t_s, &msg(sender, t_s), &[0, 1, 2, 3]);
+                    }
+                }
+            }
+            pruned.forget_stale(t_s);
+            for receiver in 0..4 {
+                assert_eq!(
+                    kept.fresh_paths(receiver, t_s),
+                    pruned.fresh_paths(receiver, t_s),
+                    "t = {t_s}"
+                );
+            }
+        }
+        assert_eq!(kept.stats(), pruned.stats());
+        let held = |bus: &V2vBus| bus.inbox.values().map(BTreeMap::len).sum::<usize>();
+        assert!(held(&pruned) <= held(&kept));
+        pruned.forget_stale(1e3);
+        assert_eq!(held(&pruned), 0);
+        assert!(held(&kept) > 0);
     }
 }

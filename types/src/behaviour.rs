@@ -51,9 +51,11 @@ pub struct Observation<'a> {
     pub mu: f64,
     /// The road.
     pub road: &'a MergeRoad,
-    /// Every other vehicle's current state (perception), in id order.
+    /// The current state of every other vehicle within the perception range (the simulator's
+    /// `perception_range_m`, 250 m by default), in id order.
     pub neighbours: &'a [Neighbour],
-    /// The shared local paths received over V2V (empty for a vehicle that is not connected).
+    /// The shared local paths received over V2V from senders within radio range (empty for a
+    /// vehicle that is not connected).
     pub shared_paths: &'a [SharedLocalPath],
 }
 

@@ -77,7 +77,8 @@ pub struct PairSafety {
     pub id_a: VehicleId,
     /// Larger id.
     pub id_b: VehicleId,
-    /// Minimum exact gap between the boxes (m); 0 when they touched.
+    /// Minimum exact gap between the boxes over the instants the pair was followed (m): its
+    /// minimum over the run whenever that is below `pair_range_m`; 0 when they touched.
     pub min_gap_m: f64,
     /// When the minimum gap was first reached (s).
     pub t_min_gap_s: f64,
@@ -98,7 +99,9 @@ pub struct PairSafety {
 pub struct SafetySummary {
     /// Every collision episode, in time order (pairs in id order within an instant).
     pub collisions: Vec<CollisionEvent>,
-    /// Minimum exact gap between any two boxes (m); `None` with fewer than two vehicles.
+    /// Minimum exact gap between any two boxes (m): the smallest of [`Self::pairs`], exact
+    /// whenever it is below `pair_range_m`; `None` when no pair was ever followed (fewer than
+    /// two vehicles, or none ever within that range).
     pub min_gap_m: Option<f64>,
     /// When `min_gap_m` was first reached (s).
     pub t_min_gap_s: Option<f64>,
@@ -112,7 +115,7 @@ pub struct SafetySummary {
     pub tet_s: f64,
     /// Every road-edge contact episode, in time order.
     pub edge_contacts: Vec<EdgeContactEvent>,
-    /// Per pair, in id order.
+    /// Per pair that was ever followed (`SafetyMonitor`'s module doc), in id order.
     pub pairs: Vec<PairSafety>,
     /// Number of checked instants.
     pub checked_instants: u64,
@@ -144,7 +147,7 @@ pub struct PairInstant {
 pub struct SafetyStepReport {
     /// The instant (s).
     pub t_s: f64,
-    /// Every pair, in id order.
+    /// Every pair followed at this instant, in id order.
     pub pairs: Vec<PairInstant>,
     /// Collision episodes that started at this instant.
     pub new_collisions: Vec<CollisionEvent>,

@@ -32,8 +32,29 @@
 //! (or to the body centre for edge checks) before the conversion, so the coordinates handed to
 //! parry are a few metres, not hundreds: the resolution is ~1 µm rather than ~60 µm at X = 700 m.
 //!
-//! # Cost
-//! Pairs are culled with bounding circles, and the culling never changes a result:
+//! # Which pairs are followed
+//! A pair is *followed* at an instant when its bounding-circle gap bound (centre distance minus
+//! both circles' radii) is at most [`SafetyParams::pair_range_m`] (250 m) or at most the distance
+//! it closes at its current relative speed over [`SafetyParams::ttc_horizon_s`]. Only followed
+//! pairs are checked, have figures and appear in the reports. That loses nothing the monitor
+//! reports: a pair not followed cannot touch (its gap exceeds the range, ≥ 10 m, which is above
+//! the contact tolerance and the near-miss gap) and has no TTC (the shape cast could not hit
+//! within the horizon), so it cannot start a collision, lower a TTC or add exposure time; and a
+//! pair's minimum gap is exact whenever it falls below the range (the instant of the minimum is
+//! followed, every other instant has a larger gap). A pair that is never followed is not
+//! listed in [`SafetySummary::pairs`]; the run's minimum gap is the smallest of the listed ones
+//! (`None` when no two vehicles ever came within the range).
+//!
+//! The followed pairs are found by sweeping the bodies sorted by X (`crate::spatial`) with a
+//! window that bounds the test: `2 r_max + max(pair_range, |Δv|_max · horizon)`, where
+//! `|Δv|_max` is the diagonal of the instant's velocity bounding box, widened by a relative
+//! 1e-9 and 1e-6 m against rounding. Every candidate then goes through the same test as with
+//! `broad_phase = false`, which visits all pairs; the two give identical results (tests), in
+//! id order. Cost: O(N log N + k) for k candidate pairs, instead of N(N − 1)/2.
+//!
+//! # Cost of a pair
+//! Followed pairs are culled further with bounding circles, and the culling never changes a
+//! result:
 //! - the exact intersection test runs only when the circles overlap;
 //! - the exact distance runs only when the circle bound could lower the pair's minimum gap
 //!   (otherwise the instant's gap is reported as a lower bound);
@@ -49,12 +70,24 @@ use std::collections::BTreeMap;
 
 use mergesim_types::{MergeRoad, VehicleId};
 
+use crate::spatial::XSweep;
+
 pub use crate::body_state::BodyState;
 pub use events::{
     CollisionEvent, EdgeContactEvent, PairInstant, PairSafety, RoadEdge, SafetyStepReport,
     SafetySummary,
 };
-pub use params::{SAFETY_BOUNDS, SafetyError, SafetyParams};
+pub use params::{DEFAULT_PAIR_RANGE_M, SAFETY_BOUNDS, SafetyError, SafetyParams};
+
+/// The bounding-circle lower bound of a pair's gap (m, ≥ 0) and its relative speed (m/s): what
+/// decides whether the pair is followed, and which exact queries it needs.
+fn pair_bounds(a: &BodyState, b: &BodyState) -> (f64, f64) {
+    let centre_distance_m = (b.x_m - a.x_m).hypot(b.y_m - a.y_m);
+    let gap_lower_bound_m =
+        (centre_distance_m - a.bounding_radius_m() - b.bounding_radius_m()).max(0.0);
+    let relative_speed_mps = (b.vx_mps - a.vx_mps).hypot(b.vy_mps - a.vy_mps);
+    (gap_lower_bound_m, relative_speed_mps)
+}
 
 /// One straight piece of a road edge, in world coordinates.
 #[derive(Clone, Copy, Debug)]
@@ -199,10 +232,8 @@ impl SafetyMonitor {
         self.report.new_edge_contacts.clear();
         self.report.min_ttc_s = None;
 
-        for (i, a) in bodies.iter().enumerate() {
-            for b in &bodies[i + 1..] {
-                self.check_pair(t_s, previous_t_s, dt_s, a, b)?;
-            }
+        for (i, j) in self.followed_pairs(bodies) {
+            self.check_pair(t_s, previous_t_s, dt_s, &bodies[i], &bodies[j])?;
         }
         if self.params.check_road_edges {
             for body in bodies {
@@ -225,6 +256,56 @@ impl SafetyMonitor {
         self.checked_instants += 1;
         self.checked_duration_s += dt_s;
         Ok(&self.report)
+    }
+
+    /// Whether the monitor follows the pair at this instant (module doc).
+    fn follows(&self, a: &BodyState, b: &BodyState) -> bool {
+        let (gap_lower_bound_m, relative_speed_mps) = pair_bounds(a, b);
+        gap_lower_bound_m
+            <= self
+                .params
+                .pair_range_m
+                .max(relative_speed_mps * self.params.ttc_horizon_s)
+    }
+
+    /// The pairs (indices into `bodies`, i < j) followed at this instant, in id order: from the
+    /// X sweep, or from all pairs without the broad phase.
+    fn followed_pairs(&self, bodies: &[BodyState]) -> Vec<(usize, usize)> {
+        let candidates: Vec<(usize, usize)> = if self.params.broad_phase {
+            let xs: Vec<f64> = bodies.iter().map(|b| b.x_m).collect();
+            XSweep::new(&xs).pairs_within_window(self.sweep_window_m(bodies))
+        } else {
+            (0..bodies.len())
+                .flat_map(|i| ((i + 1)..bodies.len()).map(move |j| (i, j)))
+                .collect()
+        };
+        candidates
+            .into_iter()
+            .filter(|&(i, j)| self.follows(&bodies[i], &bodies[j]))
+            .collect()
+    }
+
+    /// An X distance beyond which no pair is followed (module doc): a followed pair has
+    /// `|Δx| ≤ centre distance ≤ r_a + r_b + max(range, |Δv| · horizon)`.
+    fn sweep_window_m(&self, bodies: &[BodyState]) -> f64 {
+        let mut radius_m: f64 = 0.0;
+        let (mut vx_lo, mut vx_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let (mut vy_lo, mut vy_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for b in bodies {
+            radius_m = radius_m.max(b.bounding_radius_m());
+            (vx_lo, vx_hi) = (vx_lo.min(b.vx_mps), vx_hi.max(b.vx_mps));
+            (vy_lo, vy_hi) = (vy_lo.min(b.vy_mps), vy_hi.max(b.vy_mps));
+        }
+        let relative_speed_bound_mps = if bodies.is_empty() {
+            0.0
+        } else {
+            (vx_hi - vx_lo).hypot(vy_hi - vy_lo)
+        };
+        let reach_m = self
+            .params
+            .pair_range_m
+            .max(relative_speed_bound_mps * self.params.ttc_horizon_s);
+        (reach_m + 2.0 * radius_m) * (1.0 + 1e-9) + 1e-6
     }
 
     /// The outcome so far.

@@ -5,7 +5,9 @@ use parry3d::math::{Pose, Vector};
 use parry3d::query::{self, ShapeCastOptions, ShapeCastStatus};
 use parry3d::shape::Cuboid;
 
-use super::{BodyState, CollisionEvent, PairInstant, PairState, SafetyError, SafetyMonitor};
+use super::{
+    BodyState, CollisionEvent, PairInstant, PairState, SafetyError, SafetyMonitor, pair_bounds,
+};
 
 impl SafetyMonitor {
     pub(super) fn check_pair(
@@ -18,12 +20,7 @@ impl SafetyMonitor {
     ) -> Result<(), SafetyError> {
         let ttc_horizon_s = self.params.ttc_horizon_s;
         let ttc_threshold_s = self.params.ttc_threshold_s;
-        let centre_distance_m = (b.x_m - a.x_m).hypot(b.y_m - a.y_m);
-        let gap_lower_bound_m =
-            (centre_distance_m - a.bounding_radius_m() - b.bounding_radius_m()).max(0.0);
-        let rel_vx_mps = b.vx_mps - a.vx_mps;
-        let rel_vy_mps = b.vy_mps - a.vy_mps;
-        let relative_speed_mps = rel_vx_mps.hypot(rel_vy_mps);
+        let (gap_lower_bound_m, relative_speed_mps) = pair_bounds(a, b);
 
         let key = (a.id, b.id);
         let state = self.pairs.get(&key).copied();

@@ -23,7 +23,19 @@ pub struct SafetyParams {
     /// overlapping, so a physical collision shows as an exact parry distance of about zero
     /// rather than as an intersection. 0 = intersection only.
     pub contact_tolerance_m: f64,
+    /// A pair is followed at an instant when its bounding-circle gap bound is within this
+    /// distance (m), or within the distance it could close at its current relative speed over
+    /// `ttc_horizon_s` (where a TTC can be finite). So a pair's minimum gap is exact whenever
+    /// it falls below this range; a pair never followed is not listed. 250 m, the perception
+    /// range's criterion (docs/parameters.md).
+    pub pair_range_m: f64,
+    /// Find the followed pairs with the X sweep (`crate::spatial`), O(N log N + k); `false`
+    /// visits every pair, O(N²), the reference the sweep is tested against (same results).
+    pub broad_phase: bool,
 }
+
+/// Default of [`SafetyParams::pair_range_m`] (m).
+pub const DEFAULT_PAIR_RANGE_M: f64 = 250.0;
 
 impl Default for SafetyParams {
     fn default() -> Self {
@@ -33,6 +45,8 @@ impl Default for SafetyParams {
             ttc_horizon_s: 10.0,
             check_road_edges: true,
             contact_tolerance_m: 0.01,
+            pair_range_m: DEFAULT_PAIR_RANGE_M,
+            broad_phase: true,
         }
     }
 }
@@ -43,6 +57,7 @@ pub const SAFETY_BOUNDS: &[Bound] = &[
     Bound::above("ttc_horizon_s", 0.0, 60.0, "s"),
     Bound::closed("contact_tolerance_m", 0.0, 0.1, "m"),
     Bound::closed("near_miss_gap_m", 0.0, 10.0, "m"),
+    Bound::closed("pair_range_m", 10.0, 1e5, "m"),
 ];
 
 impl SafetyParams {
@@ -57,6 +72,7 @@ impl SafetyParams {
                 ("ttc_horizon_s", self.ttc_horizon_s),
                 ("contact_tolerance_m", self.contact_tolerance_m),
                 ("near_miss_gap_m", self.near_miss_gap_m),
+                ("pair_range_m", self.pair_range_m),
             ],
         )?;
         if self.ttc_horizon_s < self.ttc_threshold_s {

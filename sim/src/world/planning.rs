@@ -3,6 +3,10 @@
 //! called, broadcasts sent) in id order; the decisions themselves are computed in parallel on
 //! rayon's pool (the sweep's pool inside a sweep), which changes no result: each depends only
 //! on its vehicle's behaviour and observation.
+//!
+//! A vehicle perceives the others whose centres are within `perception_range_m`, and a
+//! broadcast reaches the connected vehicles within the V2V `range_m` of its sender, both found
+//! by the X sweep of `crate::spatial` (O(N log N + k) rather than O(N²)), in id order.
 
 use std::time::{Duration, Instant};
 
@@ -19,6 +23,7 @@ use crate::error::SimError;
 use crate::observer::{PlanView, TickObserver};
 use crate::profile::Phase;
 use crate::recording::EventLevel;
+use crate::spatial::neighbours_within;
 
 impl World {
     pub(super) fn plan_all(&mut self, t_s: f64) -> Result<(), SimError> {
@@ -42,21 +47,23 @@ impl World {
         // The observation borrows these while the world records events.
         let road = self.config.road.clone();
         let mu = self.config.mu;
-        let mut broadcasts: Vec<SharedLocalPath> = Vec::new();
+        let mut broadcasts: Vec<(usize, SharedLocalPath)> = Vec::new();
+        for (agent, kin) in self.agents.iter().zip(&kins) {
+            check_finite(t_s, &agent.spec.name, kin)?;
+        }
+        let positions: Vec<[f64; 2]> = states.iter().map(|s| [s.x_m, s.y_m]).collect();
+        let perceived = neighbours_within(&positions, self.config.perception_range_m);
+        self.bus.forget_stale(t_s);
         // 1. What each vehicle perceives and has received (sequential, by id).
         let mut inputs: Vec<(Vec<Neighbour>, Vec<SharedLocalPath>)> =
             Vec::with_capacity(self.agents.len());
-        for (index, kin) in kins.iter().enumerate() {
-            check_finite(t_s, &self.agents[index].spec.name, kin)?;
-            let neighbours: Vec<Neighbour> = self
-                .agents
+        for (index, others) in perceived.iter().enumerate() {
+            let neighbours: Vec<Neighbour> = others
                 .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != index)
-                .map(|(j, other)| Neighbour {
-                    id: other.id,
+                .map(|&j| Neighbour {
+                    id: self.agents[j].id,
                     state: states[j],
-                    shape: other.shape,
+                    shape: self.agents[j].shape,
                 })
                 .collect();
             let agent = &self.agents[index];
@@ -155,18 +162,22 @@ impl World {
             let agent = &mut self.agents[index];
             agent.path = decision.path;
             if connected && let Some(message) = decision.broadcast {
-                broadcasts.push(message);
+                broadcasts.push((index, message));
             }
         }
-        // Broadcast after everybody planned on the same information (a synchronous round).
-        let receivers: Vec<VehicleId> = self
-            .agents
-            .iter()
-            .filter(|a| a.spec.connected)
-            .map(|a| a.id)
-            .collect();
-        for message in &broadcasts {
-            self.bus.broadcast(t_s, message, &receivers);
+        // Broadcast after everybody planned on the same information (a synchronous round), to
+        // the connected vehicles in radio range of the sender.
+        if !broadcasts.is_empty() {
+            let in_radio_range = neighbours_within(&positions, self.bus.params().range_m);
+            for (sender, message) in &broadcasts {
+                let receivers: Vec<VehicleId> = in_radio_range[*sender]
+                    .iter()
+                    .map(|&j| &self.agents[j])
+                    .filter(|a| a.spec.connected)
+                    .map(|a| a.id)
+                    .collect();
+                self.bus.broadcast(t_s, message, &receivers);
+            }
         }
         if let Some(started) = started {
             self.profiler.add(

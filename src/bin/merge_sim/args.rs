@@ -166,6 +166,13 @@ pub(crate) enum ScenarioCommand {
         /// Built-in name.
         name: String,
     },
+    /// Print the platoon of `platoon_merge_50` with N vehicles as TOML (the scale scenarios of
+    /// the scaling curve; N = 50 is the built-in).
+    Platoon {
+        /// Number of vehicles (1 to 200; the upper lane takes the odd one).
+        #[arg(long, value_name = "N")]
+        vehicles: usize,
+    },
 }
 
 pub(crate) fn parse_planner(text: &str) -> Result<PlannerKind, String> {

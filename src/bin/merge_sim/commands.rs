@@ -254,6 +254,11 @@ pub(crate) fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
             })?;
             out!("{text}");
         }
+        ScenarioCommand::Platoon { vehicles } => {
+            // Checked like a scenario file before it is printed.
+            scenarios::platoon::platoon(*vehicles).map_err(|e| input(anyhow!(e)))?;
+            out!("{}", scenarios::platoon::platoon_toml(*vehicles));
+        }
     }
     Ok(())
 }
