@@ -137,10 +137,9 @@ fn plan_cycle(c: &mut Criterion) {
             (t_s, ego_k, other_k, vec![shared])
         })
         .collect();
-    // The same with the exact cone program as the convex subproblem (`speed_program = "cone"`,
-    // the default before the Newton QP).
-    let cone = PlannerParams {
-        speed_program: SpeedProgram::Cone,
+    // The same with the Newton QP as the convex subproblem (`speed_program = "newton-qp"`).
+    let newton_qp = PlannerParams {
+        speed_program: SpeedProgram::NewtonQp,
         ..planner.params().clone()
     };
     for (name, params) in [
@@ -148,7 +147,10 @@ fn plan_cycle(c: &mut Criterion) {
             "pf_iso_plan_cycle_n20_one_neighbour_moving",
             planner.params().clone(),
         ),
-        ("pf_iso_plan_cycle_n20_one_neighbour_moving_cone", cone),
+        (
+            "pf_iso_plan_cycle_n20_one_neighbour_moving_newton_qp",
+            newton_qp,
+        ),
     ] {
         let fresh = || {
             PfPlanner::new(PlannerKind::PfIso, params.clone(), planner.road().clone())

@@ -208,8 +208,8 @@ pub struct PlannerParams {
     /// Clarabel's gap and feasibility tolerances.
     pub solver_tolerance: f64,
     /// How each SCP iteration's convex subproblem is posed: `cone` (the travel time exact, one
-    /// second-order cone per segment) or `newton-qp` (its second-order model: a QP, cheaper per
-    /// solve). See `speed_optimisation::SpeedProgram`.
+    /// second-order cone per segment; default) or `newton-qp` (its second-order model: a QP,
+    /// cheaper per solve). See `speed_optimisation::SpeedProgram`.
     pub speed_program: SpeedProgram,
     /// A shared local path older than this is ignored in favour of a prediction (s).
     pub max_shared_path_age_s: f64,
@@ -317,7 +317,7 @@ impl Default for PlannerParams {
             max_jerk_mps3: 10.0,
             solver_max_iterations: 50,
             solver_tolerance: 1e-7,
-            speed_program: SpeedProgram::NewtonQp,
+            speed_program: SpeedProgram::Cone,
             max_shared_path_age_s: 0.5,
             prediction: PredictionModel::LaneFollowing,
             // Twice the smallest weight with which the risk term keeps a PF-SP follower behind

@@ -38,11 +38,12 @@
 //! # Solution
 //!
 //! Each SCP iteration solves a convex subproblem, posed one of two ways
-//! (`PlannerParams::speed_program`): [`SpeedProgram::NewtonQp`] (default) replaces the travel
-//! time by its second-order Taylor model at the iterate, a QP ([`newton_qp`]);
-//! [`SpeedProgram::Cone`] keeps it exact: t_i ≥ Δs_i / v_i ⇔ t_i v_i ≥ Δs_i, t_i, v_i ≥ 0
-//! ⇔ ‖(t_i − v_i, 2√Δs_i)‖ ≤ t_i + v_i, a second-order cone ([`cone_program`]). What follows
-//! is written for the cone program; the QP differs only where said. The interaction term is
+//! (`PlannerParams::speed_program`): [`SpeedProgram::Cone`] (default) keeps the travel time
+//! exact: t_i ≥ Δs_i / v_i ⇔ t_i v_i ≥ Δs_i, t_i, v_i ≥ 0
+//! ⇔ ‖(t_i − v_i, 2√Δs_i)‖ ≤ t_i + v_i, a second-order cone ([`cone_program`]);
+//! [`SpeedProgram::NewtonQp`] replaces it by its second-order Taylor model at the iterate, a QP
+//! ([`newton_qp`]), cheaper per solve. What follows is written for the cone program; the QP
+//! differs only where said. The interaction term is
 //! linearised at the current iterate v̄ (φ ≈ φ(v̄) + ∇φ(v̄)ᵀ(v − v̄)), the resulting convex
 //! cone program is solved inside the trust region |v_i − v̄_i| ≤ ρ, and the step d = v* − v̄
 //! to its solution v* is shortened by a backtracking line search on the true J (t = 1, ½, ¼, …
@@ -94,8 +95,9 @@ pub enum SpeedProgram {
     #[default]
     Cone,
     /// The travel time by its second-order Taylor model at the iterate: a QP with no cones and
-    /// no t variables ([`newton_qp`]), cheaper per solve; the SCP then iterates on convex
-    /// problems too.
+    /// no t variables ([`newton_qp`]), a third of the cost per solve; the SCP then iterates on
+    /// convex problems too. Not the default: in the 50-car platoon it gave more contact episodes
+    /// than the cone program (docs/parameters.md).
     NewtonQp,
 }
 
