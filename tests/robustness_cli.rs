@@ -147,6 +147,14 @@ fn work_and_parallelism_are_bounded_up_front() {
             "1 to 1024",
         ),
         (vec!["grid", "--runs", "20000"], "at most 10000"),
+        (
+            vec!["scenario", "platoon", "--vehicles", "0"],
+            "at least one vehicle",
+        ),
+        (
+            vec!["scenario", "platoon", "--vehicles", "100000"],
+            "road.start_x_m",
+        ),
     ] {
         let out = merge_sim(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
