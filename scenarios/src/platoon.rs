@@ -8,7 +8,7 @@
 //! moving back with it, so every size meets the same merge in the same way and only the queue
 //! behind it grows. With 50 vehicles the text reads back to exactly the built-in scenario.
 
-use crate::scenario::{Scenario, ScenarioError};
+use crate::scenario::{Line, Scenario, ScenarioError};
 
 /// Spacing of two vehicles in one lane (m).
 pub const LANE_SPACING_M: f64 = 50.0;
@@ -84,6 +84,18 @@ pub fn platoon_toml(vehicles: usize) -> String {
 
 /// The platoon with `vehicles` vehicles, loaded and checked like a scenario file.
 pub fn platoon(vehicles: usize) -> Result<Scenario, ScenarioError> {
+    if vehicles == 0 {
+        // The text of an empty platoon has no [[vehicles]] at all: say so, not "missing field".
+        return Err(ScenarioError::Invalid {
+            origin: "platoon --vehicles 0".into(),
+            line: Line(None),
+            field: Some("vehicles".into()),
+            message: format!(
+                "a platoon needs at least one vehicle (1 to {})",
+                sim::config::MAX_VEHICLES
+            ),
+        });
+    }
     Scenario::from_toml(
         &platoon_toml(vehicles),
         &format!("platoon --vehicles {vehicles}"),
@@ -93,6 +105,17 @@ pub fn platoon(vehicles: usize) -> Result<Scenario, ScenarioError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_empty_platoon_is_a_named_error() {
+        match platoon(0) {
+            Err(ScenarioError::Invalid { field, message, .. }) => {
+                assert_eq!(field.as_deref(), Some("vehicles"));
+                assert!(message.contains("at least one vehicle"), "{message}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
 
     #[test]
     fn fifty_vehicles_are_the_built_in_platoon() {

@@ -88,18 +88,16 @@ impl Layout {
         CscMatrix::new(2 * n, 2 * n, colptr, (0..n).collect(), vec![w2; n])
     }
 
-    /// A, row blocks as in the module doc.
-    pub(super) fn a_matrix(&self) -> CscMatrix<f64> {
+    /// Triplets (row, column, value) of the linear rows — box, acceleration, jerk, in the order
+    /// of the module doc — over the speeds at columns V_OFFSET + i. The Newton QP has exactly
+    /// these rows; the cone program adds its SOC rows after them.
+    pub(super) fn linear_triplets(&self) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
         let n = self.n;
-        // Columns: v_i at V_OFFSET + i, t_i at t_offset(n) + i.
         let v = |i: usize| V_OFFSET + i;
-        let t = |i: usize| t_offset(n) + i;
-        // Row blocks, in the order of the module doc.
         let box_hi_row = 0;
         let box_lo_row = n;
         let accel_row = 2 * n;
         let jerk_row = accel_row + self.accel_rows();
-        let soc_row = self.linear_rows();
         let (mut rows, mut cols, mut vals) = (Vec::new(), Vec::new(), Vec::new());
         let mut push = |r: usize, c: usize, value: f64| {
             rows.push(r);
@@ -130,13 +128,30 @@ impl Layout {
                 push(r + 1, v(i - 1), -1.0);
             }
         }
+        (rows, cols, vals)
+    }
+
+    /// A, row blocks as in the module doc.
+    pub(super) fn a_matrix(&self) -> CscMatrix<f64> {
+        let n = self.n;
+        // Columns: v_i at V_OFFSET + i, t_i at t_offset(n) + i.
+        let v = |i: usize| V_OFFSET + i;
+        let t = |i: usize| t_offset(n) + i;
+        let soc_row = self.linear_rows();
+        let (mut rows, mut cols, mut vals) = self.linear_triplets();
         // Second-order cones: (t_i + v_i, t_i − v_i, 2√Δs_i); the constant is in b.
         for i in 0..n {
             let r = soc_row + 3 * i;
-            push(r, t(i), -1.0);
-            push(r, v(i), -1.0);
-            push(r + 1, t(i), -1.0);
-            push(r + 1, v(i), 1.0);
+            for (row, col, value) in [
+                (r, t(i), -1.0),
+                (r, v(i), -1.0),
+                (r + 1, t(i), -1.0),
+                (r + 1, v(i), 1.0),
+            ] {
+                rows.push(row);
+                cols.push(col);
+                vals.push(value);
+            }
         }
         CscMatrix::new_from_triplets(self.rows(), 2 * n, rows, cols, vals)
     }
@@ -148,6 +163,24 @@ pub(super) struct CachedSolver {
     max_iterations: u32,
     tolerance_bits: u64,
     solver: DefaultSolver<f64>,
+}
+
+/// Clarabel's settings for both programs of the speed optimisation.
+pub(super) fn solver_settings(params: &PlannerParams) -> DefaultSettings<f64> {
+    DefaultSettings {
+        verbose: false,
+        max_iter: params.solver_max_iterations,
+        tol_gap_abs: params.solver_tolerance,
+        tol_gap_rel: params.solver_tolerance,
+        tol_feas: params.solver_tolerance,
+        presolve_enable: false,
+        // The problems are small and well scaled (A entries ±1, ±2; P diagonal; speeds of
+        // order 10): equilibration and iterative refinement cost about half the solve time
+        // here without changing the answer (closed-form test at 1e-5).
+        equilibrate_enable: false,
+        iterative_refinement_enable: false,
+        ..DefaultSettings::default()
+    }
 }
 
 pub(super) fn solver_failed(status: impl Into<String>) -> PlannerError {
@@ -210,20 +243,7 @@ impl SpeedOptimiser {
                 .as_mut()
                 .is_some_and(|c| c.solver.update_q(&q).is_ok() && c.solver.update_b(&b).is_ok());
         if !updated {
-            let settings = DefaultSettings {
-                verbose: false,
-                max_iter: params.solver_max_iterations,
-                tol_gap_abs: params.solver_tolerance,
-                tol_gap_rel: params.solver_tolerance,
-                tol_feas: params.solver_tolerance,
-                presolve_enable: false,
-                // The problem is small and well scaled (A entries ±1, ±2; P = w2 I; speeds of
-                // order 10): equilibration and iterative refinement cost about half the solve
-                // time here without changing the answer (closed-form test at 1e-5).
-                equilibrate_enable: false,
-                iterative_refinement_enable: false,
-                ..DefaultSettings::default()
-            };
+            let settings = solver_settings(params);
             let solver = DefaultSolver::new(
                 &layout.p_matrix(params.speed_deviation_weight),
                 &q,

@@ -2,7 +2,7 @@
 //! "newton-qp"`): the travel time is replaced by its second-order Taylor model at the iterate,
 //! so the SOC rows and the t variables of [`cone_program`](super::cone_program) disappear.
 //!
-//! Decision vector (N entries): x = [v_1 … v_N], offset [`V_OFFSET`].
+//! Decision vector (N entries): x = [v_1 … v_N], offset [`V_OFFSET`](super::cone_program::V_OFFSET) (as in the cone program).
 //!
 //! ```text
 //!   travel time   w1 Δs_i / v_i ≈ w1 Δs_i (1/v̄_i − (v_i − v̄_i)/v̄_i² + (v_i − v̄_i)²/v̄_i³)
@@ -26,18 +26,13 @@
 //! `update_q` and `update_b`.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettings, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus, SupportedConeT,
-};
+use clarabel::solver::{DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus, SupportedConeT};
 
 use super::SpeedProblem;
-use super::cone_program::{Layout, solver_failed};
+use super::cone_program::{Layout, solver_failed, solver_settings};
 use super::scp::SpeedOptimiser;
 use crate::error::PlannerError;
 use crate::params::PlannerParams;
-
-/// Offset of v_1 in the decision vector.
-pub const V_OFFSET: usize = 0;
 
 /// A Clarabel solver of the Newton QP and what fixes its structure.
 pub(super) struct CachedQp {
@@ -59,45 +54,11 @@ impl Layout {
         CscMatrix::new(n, n, (0..=n).collect(), (0..n).collect(), h.to_vec())
     }
 
-    /// A, row blocks as in the module doc (those of the cone program without the SOC rows).
+    /// A, row blocks as in the module doc (the cone program's linear rows, without its SOC
+    /// rows).
     fn qp_a_matrix(&self) -> CscMatrix<f64> {
-        let n = self.n;
-        let v = |i: usize| V_OFFSET + i;
-        let box_hi_row = 0;
-        let box_lo_row = n;
-        let accel_row = 2 * n;
-        let jerk_row = accel_row + self.accel_rows();
-        let (mut rows, mut cols, mut vals) = (Vec::new(), Vec::new(), Vec::new());
-        let mut push = |r: usize, c: usize, value: f64| {
-            rows.push(r);
-            cols.push(c);
-            vals.push(value);
-        };
-        for i in 0..n {
-            push(box_hi_row + i, v(i), 1.0);
-            push(box_lo_row + i, v(i), -1.0);
-        }
-        if self.accel {
-            for i in 0..n - 1 {
-                let r = accel_row + 2 * i;
-                push(r, v(i + 1), 1.0);
-                push(r, v(i), -1.0);
-                push(r + 1, v(i + 1), -1.0);
-                push(r + 1, v(i), 1.0);
-            }
-        }
-        if self.jerk {
-            for i in 1..n - 1 {
-                let r = jerk_row + 2 * (i - 1);
-                push(r, v(i + 1), 1.0);
-                push(r, v(i), -2.0);
-                push(r, v(i - 1), 1.0);
-                push(r + 1, v(i + 1), -1.0);
-                push(r + 1, v(i), 2.0);
-                push(r + 1, v(i - 1), -1.0);
-            }
-        }
-        CscMatrix::new_from_triplets(self.qp_rows(), n, rows, cols, vals)
+        let (rows, cols, vals) = self.linear_triplets();
+        CscMatrix::new_from_triplets(self.qp_rows(), self.n, rows, cols, vals)
     }
 
     fn qp_cones(&self) -> Vec<SupportedConeT<f64>> {
@@ -156,18 +117,7 @@ impl SpeedOptimiser {
                     && c.solver.update_b(&b).is_ok()
             });
         if !updated {
-            let settings = DefaultSettings {
-                verbose: false,
-                max_iter: params.solver_max_iterations,
-                tol_gap_abs: params.solver_tolerance,
-                tol_gap_rel: params.solver_tolerance,
-                tol_feas: params.solver_tolerance,
-                presolve_enable: false,
-                // As for the cone program: small, well scaled (A entries ±1, ±2).
-                equilibrate_enable: false,
-                iterative_refinement_enable: false,
-                ..DefaultSettings::default()
-            };
+            let settings = solver_settings(params);
             let solver = DefaultSolver::new(
                 &layout.qp_p_matrix(&h),
                 &q,
@@ -230,18 +180,28 @@ mod tests {
         (segment_lengths_m, max_speeds_mps)
     }
 
-    #[test]
-    fn converges_onto_the_exact_cone_solution_of_a_convex_problem() {
-        let (segment_lengths_m, max_speeds_mps) = bends();
-        let problem = SpeedProblem {
-            current_speed_mps: 15.0,
-            target_speed_mps: 18.0,
-            segment_lengths_m: &segment_lengths_m,
-            max_speeds_mps: &max_speeds_mps,
+    /// The convex problem (no interaction term) over `bends()` from `current` towards `target`.
+    fn convex<'a>(
+        segment_lengths_m: &'a [f64],
+        max_speeds_mps: &'a [f64],
+        current_speed_mps: f64,
+        target_speed_mps: f64,
+    ) -> SpeedProblem<'a> {
+        SpeedProblem {
+            current_speed_mps,
+            target_speed_mps,
+            segment_lengths_m,
+            max_speeds_mps,
             initial_guess_mps: None,
             interaction: None,
             interaction_weight: 0.0,
-        };
+        }
+    }
+
+    #[test]
+    fn converges_onto_the_exact_cone_solution_of_a_convex_problem() {
+        let (segment_lengths_m, max_speeds_mps) = bends();
+        let problem = convex(&segment_lengths_m, &max_speeds_mps, 15.0, 18.0);
         let exact = SpeedOptimiser::new()
             .solve(&params(SpeedProgram::Cone, 2), &problem)
             .unwrap();
@@ -259,15 +219,7 @@ mod tests {
     #[test]
     fn every_iterate_respects_the_acceleration_chain() {
         let (segment_lengths_m, max_speeds_mps) = bends();
-        let problem = SpeedProblem {
-            current_speed_mps: 10.0,
-            target_speed_mps: 25.0,
-            segment_lengths_m: &segment_lengths_m,
-            max_speeds_mps: &max_speeds_mps,
-            initial_guess_mps: None,
-            interaction: None,
-            interaction_weight: 0.0,
-        };
+        let problem = convex(&segment_lengths_m, &max_speeds_mps, 10.0, 25.0);
         let p = params(SpeedProgram::NewtonQp, 2);
         let solution = SpeedOptimiser::new().solve(&p, &problem).unwrap();
         let step = p.max_accel_mps2 * p.step_time_s;
@@ -288,15 +240,7 @@ mod tests {
     #[test]
     fn a_non_positive_expansion_point_is_a_typed_error_not_a_division_by_zero() {
         let (segment_lengths_m, max_speeds_mps) = bends();
-        let problem = SpeedProblem {
-            current_speed_mps: 15.0,
-            target_speed_mps: 18.0,
-            segment_lengths_m: &segment_lengths_m,
-            max_speeds_mps: &max_speeds_mps,
-            initial_guess_mps: None,
-            interaction: None,
-            interaction_weight: 0.0,
-        };
+        let problem = convex(&segment_lengths_m, &max_speeds_mps, 15.0, 18.0);
         let p = params(SpeedProgram::NewtonQp, 2);
         let layout = Layout::new(&p, 20);
         let mut at = vec![15.0; 20];

@@ -255,11 +255,6 @@ pub(crate) fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
             out!("{text}");
         }
         ScenarioCommand::Platoon { vehicles } => {
-            if *vehicles == 0 {
-                return Err(input(anyhow!(
-                    "platoon --vehicles 0: a platoon needs at least one vehicle (1 to 200)"
-                )));
-            }
             // Checked like a scenario file before it is printed.
             scenarios::platoon::platoon(*vehicles).map_err(|e| input(anyhow!(e)))?;
             out!("{}", scenarios::platoon::platoon_toml(*vehicles));
