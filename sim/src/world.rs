@@ -159,6 +159,20 @@ impl World {
         self.step_index as f64 * self.config.dt_s
     }
 
+    /// Every vehicle's kinematic state now, in id order (for a caller stepping the world by
+    /// hand with [`Self::step`], e.g. a reinforcement-learning environment).
+    pub fn kinematics(&self) -> Vec<Kinematics> {
+        self.agents
+            .iter()
+            .map(|a| a.vehicle.kinematics(&self.physics))
+            .collect()
+    }
+
+    /// Physics steps per planning cycle (`planner_period_s / dt_s`, at least one).
+    pub fn steps_per_plan(&self) -> u64 {
+        self.steps_per_plan
+    }
+
     /// Number of physics steps of the whole run.
     pub fn total_steps(&self) -> u64 {
         (self.config.duration_s / self.config.dt_s).round() as u64
