@@ -1,0 +1,42 @@
+"""mergesim from Python: cooperative merge simulations on Rapier vehicles.
+
+- :func:`run` — one run: its summary (the ``merge_sim run --json`` dict) and time series
+  (a pandas DataFrame with the ``--csv`` columns);
+- :func:`sweep` — seeded Monte-Carlo sweeps of several planners over the same instances (paired
+  by seed), run in parallel in Rust, as a pandas DataFrame;
+- :class:`MergeEnv` — a Gymnasium environment: the agent drives one vehicle through the
+  simulator's tracker, the others run the scenario's planners (also registered as
+  ``mergesim/Merge-v0``);
+- :class:`ScenarioError` (a ``ValueError``) for bad input, with ``merge_sim``'s message;
+  :class:`SimulationError` (a ``RuntimeError``) for a failure while simulating.
+
+See python/README.md.
+"""
+
+from ._native import ScenarioError, SimulationError, builtin_scenarios, planners
+from .env import MergeEnv, RewardWeights
+from .run import RunResult, run
+from .sweep import paired_differences, sweep
+
+__all__ = [
+    "MergeEnv",
+    "RewardWeights",
+    "RunResult",
+    "ScenarioError",
+    "SimulationError",
+    "builtin_scenarios",
+    "paired_differences",
+    "planners",
+    "run",
+    "sweep",
+]
+
+
+def _register() -> None:
+    import gymnasium
+
+    if "mergesim/Merge-v0" not in gymnasium.registry:
+        gymnasium.register(id="mergesim/Merge-v0", entry_point="mergesim.env:MergeEnv")
+
+
+_register()

@@ -1,0 +1,56 @@
+"""Argument conversion shared by run, sweep and the environment."""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Mapping, Optional, Union
+
+from ._native import ScenarioError
+
+#: A scenario: a built-in name, a path to a TOML file, or TOML text (any string with a line break).
+ScenarioSource = Union[str, "os.PathLike[str]"]
+
+_U64_MAX = 2**64 - 1
+
+
+def scenario_arg(scenario: ScenarioSource) -> str:
+    """The scenario argument as the native module takes it (a string)."""
+    if isinstance(scenario, (str, os.PathLike)):
+        return os.fspath(scenario)
+    raise ScenarioError(
+        f"scenario: expected a built-in name, a path or TOML text, got {type(scenario).__name__}"
+    )
+
+
+def params_json(params: Optional[Mapping[str, Any]]) -> Optional[str]:
+    """The overrides as JSON (None: no overrides)."""
+    if params is None:
+        return None
+    if not isinstance(params, Mapping):
+        raise ScenarioError(
+            "params: must be a dict of the scenario's tables and keys, "
+            f"e.g. {{'sim': {{'mu': 0.5}}}}, got {type(params).__name__}"
+        )
+    try:
+        return json.dumps(params, allow_nan=False)
+    except (TypeError, ValueError) as e:
+        raise ScenarioError(f"params: {e}") from None
+
+
+def seed_arg(name: str, seed: Optional[int], optional: bool = True) -> Optional[int]:
+    """A seed: an integer in 0..2**64-1 (None if optional)."""
+    if seed is None and optional:
+        return None
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= _U64_MAX:
+        raise ScenarioError(f"{name} = {seed!r}: need an integer from 0 to {_U64_MAX}")
+    return int(seed)
+
+
+def count_arg(name: str, value: Optional[int], optional: bool = False) -> Optional[int]:
+    """A positive integer (None if optional)."""
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ScenarioError(f"{name} = {value!r}: need a positive integer")
+    return int(value)

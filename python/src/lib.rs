@@ -1,0 +1,38 @@
+//! `mergesim._native`: the Rust half of the `mergesim` Python package (python/README.md).
+//! Scenarios load as in `merge_sim` (built-in name, path, or TOML text); bad input raises
+//! `ScenarioError` with the CLI's message; the simulations run without the GIL.
+
+mod env_core;
+mod errors;
+mod external;
+mod run;
+mod source;
+mod sweep;
+
+use pyo3::prelude::*;
+
+/// The native module.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("ScenarioError", py.get_type::<errors::ScenarioError>())?;
+    m.add("SimulationError", py.get_type::<errors::SimulationError>())?;
+    m.add_function(wrap_pyfunction!(run::run, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(builtin_scenarios, m)?)?;
+    m.add_function(wrap_pyfunction!(planners, m)?)?;
+    m.add_class::<env_core::EnvCore>()?;
+    Ok(())
+}
+
+/// Names of the built-in scenarios.
+#[pyfunction]
+fn builtin_scenarios() -> Vec<&'static str> {
+    scenarios::builtin::names()
+}
+
+/// Names of the built-in planners.
+#[pyfunction]
+fn planners() -> Vec<&'static str> {
+    planner::PlannerKind::ALL.iter().map(|k| k.name()).collect()
+}
