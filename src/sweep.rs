@@ -21,27 +21,33 @@
 //! every figure is a function of the rows in instance order, the aggregate equals that of an
 //! uninterrupted sweep (except `wall_time_s`).
 
+mod engine;
+mod figures;
 mod merge;
+mod paired;
+pub mod parquet;
 pub mod resume;
 mod rows;
 pub mod shard;
 pub mod statistics;
 mod summary;
 
-use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use std::sync::atomic::AtomicBool;
+#[cfg(test)]
+use std::sync::atomic::Ordering;
 
 use planner::PlannerKind;
-use rayon::prelude::*;
 use scenarios::Scenario;
 use sim::rng::SplitMix64;
 
 use thiserror::Error;
 
 use crate::summary::RunSummary;
-pub use merge::merge_shards;
+pub use engine::{RunRequest, run_paired_sweep_with, validate_paired};
+pub use figures::{RunFigures, VehicleRow, drawn_values};
+pub use merge::{merge_reports, merge_shards};
+pub use paired::{BetterWhen, PairedDifference, PairedSweepSummary, SweepReport};
 pub use rows::{JsonlRecord, RunMetrics, RunRow, RunStatus};
 pub use shard::{Shard, ShardError};
 pub use summary::{SweepIdentity, SweepSummary, jsonl_line};
@@ -64,6 +70,55 @@ pub struct SweepPlan {
     pub seed: u64,
     /// The part of the sweep to run.
     pub shard: Shard,
+}
+
+/// What to sweep with several planners: every instance runs with each planner, on the same seed
+/// and the same drawn values, so the planners' differences are paired (`merge_sim sweep
+/// --planners`).
+#[derive(Clone, Debug)]
+pub struct PairedSweepPlan {
+    /// The scenario (nominal values and randomisation ranges).
+    pub scenario: Scenario,
+    /// Planners of every planner-driven vehicle, the first the baseline of the paired
+    /// differences; empty: the scenario's own planners (one pass, like `planner: None`).
+    pub planners: Vec<PlannerKind>,
+    /// Instances in the whole sweep (≥ 1); each runs once per planner.
+    pub runs: u64,
+    /// Sweep seed K.
+    pub seed: u64,
+    /// The part of the sweep to run (all planners of an instance are in the same shard).
+    pub shard: Shard,
+}
+
+impl PairedSweepPlan {
+    /// The planner overrides in order (`[None]`: the scenario's own).
+    pub fn overrides(&self) -> Vec<Option<PlannerKind>> {
+        if self.planners.is_empty() {
+            vec![None]
+        } else {
+            self.planners.iter().copied().map(Some).collect()
+        }
+    }
+
+    /// The row label of each planner in order (its name; the scenario's own label without one).
+    pub fn labels(&self) -> Vec<String> {
+        self.overrides()
+            .into_iter()
+            .map(|k| planner_label(&self.scenario, k))
+            .collect()
+    }
+}
+
+impl From<&SweepPlan> for PairedSweepPlan {
+    fn from(plan: &SweepPlan) -> Self {
+        PairedSweepPlan {
+            scenario: plan.scenario.clone(),
+            planners: plan.planner.into_iter().collect(),
+            runs: plan.runs,
+            seed: plan.seed,
+            shard: plan.shard,
+        }
+    }
 }
 
 /// How to run a sweep (does not change its results).
@@ -166,6 +221,62 @@ impl SweepOutcome {
     }
 }
 
+/// A finished multi-planner sweep (or the part of it that finished before an interruption).
+#[derive(Clone, Debug)]
+pub struct PairedSweepOutcome {
+    /// Each planner's aggregate, in the plan's order (the first the baseline).
+    pub summaries: Vec<SweepSummary>,
+    /// Wall time of each row of each planner's `samples` (s), in instance order.
+    pub run_wall_times_s: Vec<Vec<f64>>,
+    /// Runs finished by this attempt (not resumed), over every planner.
+    pub new_runs: u64,
+    /// Whether the interrupt flag stopped the sweep before every run finished.
+    pub interrupted: bool,
+    /// Wall time of the whole sweep (s); not reproducible.
+    pub wall_time_s: f64,
+}
+
+impl PairedSweepOutcome {
+    /// How the sweep ended, over every planner's runs.
+    pub fn verdict(&self) -> SweepVerdict {
+        let sum = |f: fn(&SweepSummary) -> u64| self.summaries.iter().map(f).sum::<u64>();
+        let (missing, failed) = (sum(|s| s.missing_runs), sum(|s| s.diverged));
+        if missing > 0 {
+            SweepVerdict::Interrupted { missing }
+        } else if failed > 0 {
+            SweepVerdict::RunsFailed {
+                failed,
+                of: sum(|s| s.runs),
+            }
+        } else {
+            SweepVerdict::Complete
+        }
+    }
+
+    /// The report (`--json`): one planner's [`SweepSummary`] as a single-planner sweep writes
+    /// it, or with several planners the [`PairedSweepSummary`] (per-planner aggregates and the
+    /// paired differences against the first).
+    pub fn report(&self) -> SweepReport {
+        match self.summaries.as_slice() {
+            [single] => SweepReport::Single(Box::new(single.clone())),
+            _ => SweepReport::Paired(PairedSweepSummary::from_summaries(
+                self.summaries.clone(),
+                self.wall_time_s,
+            )),
+        }
+    }
+}
+
+/// The warning for a sweep of a scenario without `[randomise]`: every instance is the same run.
+pub fn unrandomised_warning(scenario: &Scenario) -> Option<String> {
+    scenario.randomise.is_empty().then(|| {
+        format!(
+            "scenario {} randomises nothing: every instance is the same run",
+            scenario.name
+        )
+    })
+}
+
 /// The planner name of a sweep: the override, or the scenario's single planner, or `mixed`.
 pub fn planner_label(scenario: &Scenario, planner: Option<PlannerKind>) -> String {
     crate::experiment::planner_label(scenario, planner.map(|k| k.name()))
@@ -182,14 +293,25 @@ pub fn simulate_instance_until(
     seed: u64,
     interrupt: Option<Arc<AtomicBool>>,
 ) -> Result<RunSummary, sim::SimError> {
+    simulate_run(&plan.scenario, plan.planner, seed, interrupt)
+}
+
+/// Runs instance `seed` of `scenario` with `planner` (`None`: the scenario's own): what
+/// `merge_sim run --scenario S [--planner P] --seed <seed>` runs.
+pub fn simulate_run(
+    scenario: &Scenario,
+    planner: Option<PlannerKind>,
+    seed: u64,
+    interrupt: Option<Arc<AtomicBool>>,
+) -> Result<RunSummary, sim::SimError> {
     let options = crate::experiment::InstanceOptions {
-        planner: plan.planner.map(|k| k.name().to_string()),
+        planner: planner.map(|k| k.name().to_string()),
         seed: Some(seed),
         keep_time_series: false,
         interrupt,
         profile: false,
     };
-    crate::experiment::run_quietly(&plan.scenario, &options)
+    crate::experiment::run_quietly(scenario, &options)
         .map(|finished| finished.summary)
         .map_err(|e| match e {
             crate::experiment::RunError::Setup(e) | crate::experiment::RunError::Run(e) => e,
@@ -204,63 +326,43 @@ pub fn run_sweep(
     options: &SweepOptions,
     on_run: &(dyn Fn(&FinishedRun) + Sync),
 ) -> Result<SweepOutcome, SweepError> {
+    run_paired_sweep(&PairedSweepPlan::from(plan), options, on_run).map(single_outcome)
+}
+
+/// Runs the plan's shard with the simulator, every instance once per planner (the library
+/// entry of `merge_sim sweep --planners`); `on_run` is called with each run as it finishes
+/// (from the worker threads, in completion order). The rows, aggregates and paired differences
+/// do not depend on the thread count or the scheduling.
+pub fn run_paired_sweep(
+    plan: &PairedSweepPlan,
+    options: &SweepOptions,
+    on_run: &(dyn Fn(&FinishedRun) + Sync),
+) -> Result<PairedSweepOutcome, SweepError> {
     let interrupt = options.interrupt.clone();
-    run_sweep_with(plan, options, on_run, |seed| match simulate_instance_until(
+    run_paired_sweep_with(
         plan,
-        seed,
-        interrupt.clone(),
-    ) {
-        Ok(summary) => Ok(RunMetrics::of(&summary)),
-        Err(sim::SimError::Interrupted { .. }) => Err(RunFailure::Interrupted),
-        Err(e) => Err(RunFailure::Failed(e.to_string())),
-    })
+        options,
+        on_run,
+        |request: &RunRequest| match simulate_run(
+            &plan.scenario,
+            request.planner,
+            request.seed,
+            interrupt.clone(),
+        ) {
+            Ok(summary) => Ok(RunFigures::of(&summary)),
+            Err(sim::SimError::Interrupted { .. }) => Err(RunFailure::Interrupted),
+            Err(e) => Err(RunFailure::Failed(e.to_string())),
+        },
+    )
 }
 
 /// Checks a plan and its options before any work.
 pub fn validate(plan: &SweepPlan, options: &SweepOptions) -> Result<(), SweepError> {
-    if plan.runs == 0 || plan.runs > MAX_RUNS {
-        return Err(SweepError::Invalid(format!(
-            "runs = {}: a sweep runs 1 to {MAX_RUNS} instances (for more, run several sweeps \
-             with different seeds)",
-            plan.runs
-        )));
-    }
-    if let Some(threads) = options.threads
-        && !(1..=MAX_THREADS).contains(&threads)
-    {
-        return Err(SweepError::Invalid(format!(
-            "threads = {threads}: need 1 to {MAX_THREADS}"
-        )));
-    }
-    let range = plan.shard.instances(plan.runs);
-    let mut seen = std::collections::BTreeSet::new();
-    for run in &options.resume {
-        let row = &run.row;
-        if !range.contains(&row.instance) {
-            return Err(SweepError::Invalid(format!(
-                "resumed row of instance {} lies outside shard {}'s instances {}..{}",
-                row.instance, plan.shard, range.start, range.end
-            )));
-        }
-        let expected = instance_seed(plan.seed, row.instance);
-        if row.seed != expected {
-            return Err(SweepError::Invalid(format!(
-                "resumed row of instance {} has seed {}, not {expected} = the seed of instance \
-                 {} of a sweep with seed {}: not a row of this sweep",
-                row.instance, row.seed, row.instance, plan.seed
-            )));
-        }
-        if !seen.insert(row.instance) {
-            return Err(SweepError::Invalid(format!(
-                "instance {} appears twice among the resumed rows",
-                row.instance
-            )));
-        }
-    }
-    Ok(())
+    validate_paired(&PairedSweepPlan::from(plan), options)
 }
 
-/// [`run_sweep`] with any runner (`seed → figures or failure`), e.g. a fake one in tests.
+/// [`run_sweep`] with any runner (`seed → figures or failure`), e.g. a fake one in tests (its
+/// rows have no per-vehicle figures).
 pub fn run_sweep_with<F>(
     plan: &SweepPlan,
     options: &SweepOptions,
@@ -270,83 +372,55 @@ pub fn run_sweep_with<F>(
 where
     F: Fn(u64) -> Result<RunMetrics, RunFailure> + Sync,
 {
-    validate(plan, options)?;
-    let identity = SweepIdentity::of(plan);
-    let range = plan.shard.instances(plan.runs);
-    let done: std::collections::BTreeSet<u64> =
-        options.resume.iter().map(|r| r.row.instance).collect();
-    let todo: Vec<u64> = range.clone().filter(|i| !done.contains(i)).collect();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(options.threads.unwrap_or(0))
-        // A World keeps sizeable locals on the stack; give the workers the main thread's 8 MiB
-        // and some margin rather than the 2 MiB default of spawned threads.
-        .stack_size(16 << 20)
-        .build()
-        .map_err(|e| SweepError::Threads(e.to_string()))?;
-    let interrupted = || {
-        options
-            .interrupt
-            .as_ref()
-            .is_some_and(|flag| flag.load(Ordering::Relaxed))
-    };
-    let started = Instant::now();
-    let new_runs: Vec<FinishedRun> = pool.install(|| {
-        todo.into_par_iter()
-            .filter_map(|instance| {
-                if interrupted() {
-                    return None;
-                }
-                let seed = instance_seed(plan.seed, instance);
-                let run_started = Instant::now();
-                let result = catch_unwind(AssertUnwindSafe(|| runner(seed)));
-                let wall_time_s = run_started.elapsed().as_secs_f64();
-                let (status, error, metrics) = match result {
-                    Ok(Ok(metrics)) => (RunStatus::Completed, None, Some(metrics)),
-                    Ok(Err(RunFailure::Interrupted)) => return None,
-                    Ok(Err(RunFailure::Failed(error))) => (RunStatus::Diverged, Some(error), None),
-                    Err(payload) => (
-                        RunStatus::Panicked,
-                        Some(panic_message(payload.as_ref())),
-                        None,
-                    ),
-                };
-                let run = FinishedRun {
-                    row: RunRow {
-                        instance,
-                        seed,
-                        status,
-                        error,
-                        metrics,
-                    },
-                    wall_time_s,
-                };
-                on_run(&run);
-                Some(run)
+    run_paired_sweep_with(
+        &PairedSweepPlan::from(plan),
+        options,
+        on_run,
+        |request: &RunRequest| {
+            runner(request.seed).map(|metrics| RunFigures {
+                metrics,
+                vehicles: Vec::new(),
             })
-            .collect()
-    });
-    let wall_time_s = started.elapsed().as_secs_f64();
-    let new_count = new_runs.len() as u64;
-    let mut all: Vec<FinishedRun> = options.resume.iter().cloned().chain(new_runs).collect();
-    all.sort_by_key(|r| r.row.instance);
-    let (rows, run_wall_times_s): (Vec<RunRow>, Vec<f64>) =
-        all.into_iter().map(|r| (r.row, r.wall_time_s)).unzip();
-    let summary = SweepSummary::from_rows(&identity, plan.shard, rows, wall_time_s);
-    Ok(SweepOutcome {
-        interrupted: summary.missing_runs > 0,
-        summary,
-        run_wall_times_s,
-        new_runs: new_count,
-    })
+        },
+    )
+    .map(single_outcome)
 }
 
-fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
-    let text = payload
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "unknown payload".into());
-    format!("panic: {text}")
+/// The outcome of a one-planner [`PairedSweepOutcome`].
+fn single_outcome(outcome: PairedSweepOutcome) -> SweepOutcome {
+    let PairedSweepOutcome {
+        summaries,
+        run_wall_times_s,
+        new_runs,
+        interrupted,
+        ..
+    } = outcome;
+    // A plan of one planner gives exactly one summary (engine invariant).
+    let summary = summaries.into_iter().next().unwrap_or_else(|| {
+        SweepSummary::from_rows(
+            &SweepIdentity {
+                scenario: String::new(),
+                scenario_fingerprint: String::new(),
+                params: String::new(),
+                planner: String::new(),
+                planners: Vec::new(),
+                seed: 0,
+                total_runs: 0,
+            },
+            Shard::WHOLE,
+            Vec::new(),
+            0.0,
+        )
+    });
+    SweepOutcome {
+        summary,
+        run_wall_times_s: run_wall_times_s.into_iter().next().unwrap_or_default(),
+        new_runs,
+        interrupted,
+    }
 }
+
+#[cfg(test)]
+mod paired_tests;
 #[cfg(test)]
 mod tests;

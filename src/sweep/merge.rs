@@ -1,6 +1,59 @@
 //! Merging the shards of one sweep into the aggregate of the whole (`merge_sim merge-results`).
 
-use super::{Shard, SweepError, SweepSummary, instance_seed};
+use super::paired::check_paired;
+use super::{PairedSweepSummary, Shard, SweepError, SweepReport, SweepSummary, instance_seed};
+
+/// Combines the `--json` reports of the shards of one sweep (`(origin, report)`), single- or
+/// multi-planner: a multi-planner sweep is merged planner by planner ([`merge_shards`]) and its
+/// paired differences computed again from the merged rows, so they equal the unsharded sweep's.
+pub fn merge_reports(parts: Vec<(String, SweepReport)>) -> Result<SweepReport, SweepError> {
+    let Some((first_origin, first)) = parts.first() else {
+        return Err(SweepError::Invalid("no shard files given".into()));
+    };
+    let planners = first.planners();
+    let paired = matches!(first, SweepReport::Paired(_));
+    for (origin, part) in &parts {
+        if let SweepReport::Paired(p) = part {
+            check_paired(origin, p)?;
+        }
+        if matches!(part, SweepReport::Paired(_)) != paired || part.planners() != planners {
+            return Err(SweepError::Invalid(format!(
+                "{origin}: planners = {} differ from {first_origin} ({}): not a shard of the \
+                 same sweep",
+                part.planners().join(","),
+                planners.join(",")
+            )));
+        }
+    }
+    if !paired {
+        let singles = parts
+            .into_iter()
+            .filter_map(|(origin, part)| match part {
+                SweepReport::Single(s) => Some((origin, *s)),
+                SweepReport::Paired(_) => None,
+            })
+            .collect();
+        return merge_shards(singles).map(|s| SweepReport::Single(Box::new(s)));
+    }
+    let mut wall_time_s = 0.0;
+    let mut by_planner: Vec<Vec<(String, SweepSummary)>> = vec![Vec::new(); planners.len()];
+    for (origin, part) in parts {
+        if let SweepReport::Paired(p) = part {
+            wall_time_s += p.wall_time_s;
+            for (slot, summary) in by_planner.iter_mut().zip(p.per_planner) {
+                slot.push((origin.clone(), summary));
+            }
+        }
+    }
+    let summaries = by_planner
+        .into_iter()
+        .map(merge_shards)
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(SweepReport::Paired(PairedSweepSummary::from_summaries(
+        summaries,
+        wall_time_s,
+    )))
+}
 
 /// Combines the summaries of shards (`(origin, summary)`, origin naming the file in errors) into
 /// the summary of the whole sweep: same identity, every shard `i/n` present exactly once.

@@ -17,8 +17,8 @@ pub struct ResumedRows {
 
 /// Reads the runs of the JSONL `text` (from `origin`, named in errors) written by a sweep
 /// with identity `identity`. Every complete line must be a row of that sweep: a line of another
-/// sweep (scenario, fingerprint, parameter set, planner, seed or run count differ) or one that
-/// does not parse is an error naming its line and field.
+/// sweep (scenario, fingerprint, parameter set, planner list, seed or run count differ), of
+/// an older mergesim, or one that does not parse is an error naming its line and field.
 pub fn read_jsonl(
     text: &str,
     origin: &str,
@@ -38,6 +38,13 @@ pub fn read_jsonl(
                 "{origin}, line {number}: not a row of `merge_sim sweep --jsonl`: {e}"
             ))
         })?;
+        let Some(planners) = &record.planners else {
+            return Err(SweepError::Invalid(format!(
+                "{origin}, line {number}: no `planners`: a row written by an older mergesim \
+                 (rows now carry `planner`, `drawn` and `vehicles`); start a new sweep (a new \
+                 --jsonl file)"
+            )));
+        };
         let fields = [
             ("scenario", &identity.scenario, &record.scenario),
             ("params", &identity.params, &record.params),
@@ -46,7 +53,11 @@ pub fn read_jsonl(
                 &identity.scenario_fingerprint,
                 &record.scenario_fingerprint,
             ),
-            ("planner", &identity.planner, &record.planner),
+            (
+                "planners",
+                &identity.planners.join(","),
+                &planners.join(","),
+            ),
             (
                 "sweep_seed",
                 &identity.seed.to_string(),
@@ -83,9 +94,18 @@ pub fn read_jsonl(
                 record.row.seed
             )));
         }
-        if let Some(first) = seen.insert(instance, number) {
+        let planner = &record.row.planner;
+        if !identity.planners.contains(planner) {
             return Err(SweepError::Invalid(format!(
-                "{origin}, line {number}: instance {instance} appears twice (also line {first})"
+                "{origin}, line {number}: planner = {planner}, not one of this sweep's planners \
+                 ({}): the file holds rows of another sweep",
+                identity.planners.join(",")
+            )));
+        }
+        if let Some(first) = seen.insert((instance, planner.clone()), number) {
+            return Err(SweepError::Invalid(format!(
+                "{origin}, line {number}: instance {instance} ({planner}) appears twice (also \
+                 line {first})"
             )));
         }
         runs.push(FinishedRun {

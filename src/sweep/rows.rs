@@ -1,7 +1,10 @@
 //! One run of a sweep: its status, its figures, its row (in the aggregate and in the JSONL).
 
+use std::collections::BTreeMap;
+
 use serde::{Deserialize, Serialize};
 
+use super::VehicleRow;
 use crate::summary::RunSummary;
 
 /// How a run ended.
@@ -81,14 +84,18 @@ impl RunMetrics {
     }
 }
 
-/// One run of a sweep (one JSONL line, without the wall time; one element of `samples`).
+/// One run of a sweep: one planner on one instance (one JSONL line, without the wall time; one
+/// element of `samples`). Its key is (`instance`, `planner`).
 ///
 /// Read strictly: a `completed` row must carry every figure, well formed (a malformed figure is
-/// an error naming the instance, never a silently "diverged" run).
+/// an error naming the instance, never a silently "diverged" run); a row without `planner` or
+/// `drawn` was written by an older mergesim and is refused with a message saying so.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RunRow {
     /// Instance index i in `0..runs`.
     pub instance: u64,
+    /// The planner of the run (its name, or the scenario's own label: `pf-iso`, `mixed`).
+    pub planner: String,
     /// The run's seed, [`instance_seed`](super::instance_seed)`(K, i)`: `merge_sim run --seed
     /// <seed>` replays it. A string in JSON (exact in every reader); integers are read too.
     #[serde(with = "crate::exact_seed")]
@@ -98,10 +105,19 @@ pub struct RunRow {
     /// The error of a diverged or panicked run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// The values the scenario drew for this instance (see
+    /// [`drawn_values`](super::drawn_values)); the same for every planner of an instance.
+    pub drawn: BTreeMap<String, f64>,
     /// The figures of a completed run (absent otherwise).
     #[serde(flatten)]
     pub metrics: Option<RunMetrics>,
+    /// Each vehicle's figures, in the scenario's order (empty unless completed).
+    pub vehicles: Vec<VehicleRow>,
 }
+
+/// Why a row written by an older mergesim cannot be read.
+const OLD_FORMAT: &str = "written by an older mergesim (rows now carry `planner`, `drawn` and \
+                          `vehicles`): start a new sweep (a new --jsonl file)";
 
 impl<'de> Deserialize<'de> for RunRow {
     fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
@@ -109,32 +125,55 @@ impl<'de> Deserialize<'de> for RunRow {
         #[derive(Deserialize)]
         struct Raw {
             instance: u64,
+            #[serde(default)]
+            planner: Option<String>,
             #[serde(with = "crate::exact_seed")]
             seed: u64,
             status: RunStatus,
             #[serde(default)]
             error: Option<String>,
+            #[serde(default)]
+            drawn: Option<BTreeMap<String, f64>>,
+            #[serde(default)]
+            vehicles: Option<Vec<VehicleRow>>,
             #[serde(flatten)]
             rest: serde_json::Map<String, serde_json::Value>,
         }
         let raw = Raw::deserialize(deserializer)?;
-        let metrics = match raw.status {
-            RunStatus::Completed => Some(
-                RunMetrics::deserialize(serde_json::Value::Object(raw.rest)).map_err(|e| {
+        let instance = raw.instance;
+        let (Some(planner), Some(drawn)) = (raw.planner, raw.drawn) else {
+            return Err(D::Error::custom(format!(
+                "instance {instance}: a row without `planner` or `drawn`, {OLD_FORMAT}"
+            )));
+        };
+        let (metrics, vehicles) = match raw.status {
+            RunStatus::Completed => {
+                let metrics = RunMetrics::deserialize(serde_json::Value::Object(raw.rest))
+                    .map_err(|e| {
+                        D::Error::custom(format!(
+                            "instance {instance} ({planner}): a completed run with missing or \
+                             malformed figures: {e}"
+                        ))
+                    })?;
+                let vehicles = raw.vehicles.ok_or_else(|| {
                     D::Error::custom(format!(
-                        "instance {}: a completed run with missing or malformed figures: {e}",
-                        raw.instance
+                        "instance {instance} ({planner}): a completed run without `vehicles`, \
+                         {OLD_FORMAT}"
                     ))
-                })?,
-            ),
-            RunStatus::Diverged | RunStatus::Panicked => None,
+                })?;
+                (Some(metrics), vehicles)
+            }
+            RunStatus::Diverged | RunStatus::Panicked => (None, raw.vehicles.unwrap_or_default()),
         };
         Ok(RunRow {
-            instance: raw.instance,
+            instance,
+            planner,
             seed: raw.seed,
             status: raw.status,
             error: raw.error,
+            drawn,
             metrics,
+            vehicles,
         })
     }
 }
@@ -145,7 +184,7 @@ pub(super) struct JsonlLine<'a> {
     pub(super) scenario: &'a str,
     pub(super) scenario_fingerprint: &'a str,
     pub(super) params: &'a str,
-    pub(super) planner: &'a str,
+    pub(super) planners: &'a [String],
     #[serde(with = "crate::exact_seed")]
     pub(super) sweep_seed: u64,
     pub(super) total_runs: u64,
@@ -163,8 +202,10 @@ pub struct JsonlRecord {
     pub scenario_fingerprint: String,
     /// Planner parameter set.
     pub params: String,
-    /// Planner label.
-    pub planner: String,
+    /// The planners of the sweep, the first the baseline (`None`: a line of an older mergesim,
+    /// refused by the reader).
+    #[serde(default)]
+    pub planners: Option<Vec<String>>,
     /// Sweep seed K.
     #[serde(with = "crate::exact_seed")]
     pub sweep_seed: u64,

@@ -60,6 +60,18 @@ pub fn mean(values: &[f64]) -> Option<f64> {
     }
 }
 
+/// Standard error of the mean of `values`: the sample standard deviation (n − 1) over √n,
+/// summed in the given order. `None` for fewer than two values.
+pub fn standard_error(values: &[f64]) -> Option<f64> {
+    let m = mean(values)?;
+    if values.len() < 2 {
+        return None;
+    }
+    let n = values.len() as f64;
+    let variance = values.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0);
+    Some((variance / n).sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -124,5 +136,16 @@ mod tests {
     fn mean_of_values() {
         assert_eq!(mean(&[1.0, 2.0, 6.0]), Some(3.0));
         assert_eq!(mean(&[]), None);
+    }
+
+    #[test]
+    fn standard_error_of_values() {
+        // Sample variance of 1, 2, 6 is ((−2)² + (−1)² + 3²) / 2 = 7; SE = √(7/3).
+        assert_eq!(
+            standard_error(&[1.0, 2.0, 6.0]),
+            Some((7.0f64 / 3.0).sqrt())
+        );
+        assert_eq!(standard_error(&[4.0]), None);
+        assert_eq!(standard_error(&[]), None);
     }
 }

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::rows::JsonlLine;
 use super::statistics::{Z_95, mean, nearest_rank_percentile, wilson_interval};
-use super::{RunMetrics, RunRow, RunStatus, Shard, SweepPlan, planner_label};
+use super::{PairedSweepPlan, RunMetrics, RunRow, RunStatus, Shard, SweepPlan};
 
 /// The aggregate of a sweep or of one shard (the `--json` file). The per-run `samples` are
 /// kept so that shards can be merged into exactly the unsharded aggregate.
@@ -88,7 +88,7 @@ pub fn jsonl_line(
         scenario: &identity.scenario,
         scenario_fingerprint: &identity.scenario_fingerprint,
         params: &identity.params,
-        planner: &identity.planner,
+        planners: &identity.planners,
         sweep_seed: identity.seed,
         total_runs: identity.total_runs,
         row,
@@ -105,8 +105,11 @@ pub struct SweepIdentity {
     pub scenario_fingerprint: String,
     /// Planner parameter set.
     pub params: String,
-    /// Planner name.
+    /// Planner name (of a multi-planner sweep: the names joined with commas).
     pub planner: String,
+    /// Every planner of the sweep, the first the baseline (in each JSONL line: part of what
+    /// identifies the sweep).
+    pub planners: Vec<String>,
     /// Sweep seed.
     pub seed: u64,
     /// Instances in the whole sweep.
@@ -116,14 +119,29 @@ pub struct SweepIdentity {
 impl SweepIdentity {
     /// The identity of a plan.
     pub fn of(plan: &SweepPlan) -> Self {
+        Self::of_paired(&PairedSweepPlan::from(plan))
+    }
+
+    /// The identity of a (multi-planner) plan.
+    pub fn of_paired(plan: &PairedSweepPlan) -> Self {
         let canonical = plan.scenario.to_toml().unwrap_or_default();
+        let planners = plan.labels();
         SweepIdentity {
             scenario: plan.scenario.name.clone(),
             scenario_fingerprint: format!("{:016x}", fnv1a64(&canonical)),
             params: plan.scenario.params.name().to_string(),
-            planner: planner_label(&plan.scenario, plan.planner),
+            planner: planners.join(","),
+            planners,
             seed: plan.seed,
             total_runs: plan.runs,
+        }
+    }
+
+    /// The identity of one planner's aggregate within this sweep.
+    pub fn for_planner(&self, planner: &str) -> Self {
+        SweepIdentity {
+            planner: planner.to_string(),
+            ..self.clone()
         }
     }
 }
@@ -194,6 +212,7 @@ impl SweepSummary {
             scenario_fingerprint: self.scenario_fingerprint.clone(),
             params: self.params.clone(),
             planner: self.planner.clone(),
+            planners: vec![self.planner.clone()],
             seed: self.seed,
             total_runs: self.total_runs,
         }

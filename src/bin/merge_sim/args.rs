@@ -188,9 +188,18 @@ pub(crate) struct SweepArgs {
     #[command(flatten)]
     pub(crate) source: ScenarioArgs,
     /// Planner of every planner-driven vehicle (overrides the scenario's choice).
-    #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
+    #[arg(long, value_name = "PLANNER", value_parser = parse_planner, conflicts_with = "planners")]
     pub(crate) planner: Option<PlannerKind>,
-    /// Number of randomised instances in the whole sweep (1 to 1000000).
+    /// Paired sweep: run every instance with each of these planners (comma-separated; same
+    /// seed, same drawn values) and report each planner's aggregate and the paired differences
+    /// of each planner against the FIRST (the baseline): mean ± standard error of (planner −
+    /// baseline) and the instances where it is better / worse / tied, for collisions, near
+    /// misses, min gap, min TTC, peak yaw rate, peak sideslip, min speed and each vehicle's
+    /// figures and the paper's. One name is the same as --planner.
+    #[arg(long, value_name = "P1,P2,...", value_delimiter = ',', value_parser = parse_planner)]
+    pub(crate) planners: Vec<PlannerKind>,
+    /// Number of randomised instances in the whole sweep (1 to 1000000); each runs once per
+    /// planner.
     #[arg(long, value_name = "N", value_parser = parse_runs)]
     pub(crate) runs: u64,
     /// Sweep seed K: instance i runs with seed SplitMix64::derive(K, i), which `run --seed`
@@ -205,16 +214,21 @@ pub(crate) struct SweepArgs {
     /// Write the aggregate JSON here (with per-run samples, so shards can be merged).
     #[arg(long, value_name = "PATH")]
     pub(crate) json: Option<PathBuf>,
-    /// Append one JSON line per run here as it finishes (the sweep's identity, instance, seed,
-    /// status, figures, wall time), flushed at once, so an interrupted sweep loses no finished
-    /// run. An existing file is refused unless --resume is given.
+    /// Append one JSON line per run here as it finishes (the sweep's identity with its
+    /// planners, instance, planner, seed, status, the drawn values under `drawn`, the figures,
+    /// each vehicle's figures under `vehicles`, wall time), flushed at once, so an interrupted
+    /// sweep loses no finished run. An existing file is refused unless --resume is given.
     #[arg(long, value_name = "PATH")]
     pub(crate) jsonl: Option<PathBuf>,
     /// Complete an interrupted sweep: read the --jsonl file of the same sweep (same scenario,
-    /// parameters, planner, --runs, --seed and shard), run only the instances it lacks and
-    /// append them; the aggregate then equals an uninterrupted sweep's.
+    /// parameters, planner(s), --runs, --seed and shard), run only the (instance, planner) runs
+    /// it lacks and append them; the aggregate then equals an uninterrupted sweep's.
     #[arg(long, requires = "jsonl")]
     pub(crate) resume: bool,
+    /// Write every row (instance, planner, seed, status, error, run figures, `drawn.<name>`,
+    /// `<vehicle>.<figure>`) as one Parquet file here (seed as uint64).
+    #[arg(long, value_name = "PATH")]
+    pub(crate) parquet: Option<PathBuf>,
     /// Worker threads [default: one per core].
     #[arg(long, value_name = "N", value_parser = parse_threads)]
     pub(crate) threads: Option<usize>,
@@ -231,6 +245,9 @@ pub(crate) struct MergeResultsArgs {
     /// Write the aggregate of the whole sweep here.
     #[arg(long, value_name = "PATH")]
     pub(crate) json: Option<PathBuf>,
+    /// Write the rows of the whole sweep as one Parquet file here (as `sweep --parquet`).
+    #[arg(long, value_name = "PATH")]
+    pub(crate) parquet: Option<PathBuf>,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub(crate) quiet: bool,

@@ -265,7 +265,8 @@ pub(crate) fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
 
 pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), Failure> {
     use mergesim::sweep::{
-        Shard, SweepIdentity, SweepOptions, SweepPlan, resume::read_jsonl, run_sweep, validate,
+        PairedSweepPlan, Shard, SweepIdentity, SweepOptions, resume::read_jsonl, run_paired_sweep,
+        validate_paired,
     };
     let scenario = load_scenario(&args.source.scenario, args.source.params)?;
     // An existing JSONL passes (a regular file): --resume reads it back, else it is refused
@@ -274,6 +275,7 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
         &[
             (args.json.as_deref(), "--json"),
             (args.jsonl.as_deref(), "--jsonl"),
+            (args.parquet.as_deref(), "--parquet"),
         ],
         &scenario_file(&args.source.scenario),
     )?;
@@ -283,14 +285,19 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
             .map_err(input)?
             .unwrap_or(Shard::WHOLE),
     };
-    let plan = SweepPlan {
+    // `--planner P` and `--planners P` are the same sweep.
+    let planners = match args.planner {
+        Some(kind) => vec![kind],
+        None => args.planners.clone(),
+    };
+    let plan = PairedSweepPlan {
         scenario,
-        planner: args.planner,
+        planners,
         runs: args.runs,
         seed: args.seed,
         shard,
     };
-    let identity = SweepIdentity::of(&plan);
+    let identity = SweepIdentity::of_paired(&plan);
     // The JSONL: a fresh file, or (--resume) the rows of the interrupted attempt.
     let mut resume = Vec::new();
     let jsonl = match &args.jsonl {
@@ -337,13 +344,15 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
         resume,
     };
     // Every check before any work or any write.
-    validate(&plan, &options).map_err(sweep_failure)?;
+    validate_paired(&plan, &options).map_err(sweep_failure)?;
     let writer = match &jsonl {
         None => None,
         Some((path, complete_len)) => Some(std::sync::Mutex::new(open_jsonl(path, *complete_len)?)),
     };
     let instances = shard.instances(args.runs);
-    let to_run = (instances.end - instances.start) - options.resume.len() as u64;
+    let planner_count = identity.planners.len() as u64;
+    let expected_runs = (instances.end - instances.start) * planner_count;
+    let to_run = expected_runs - options.resume.len() as u64;
     // The shard banner goes to stderr even with --quiet: a job log then says what ran.
     eprintln!(
         "sweep {} {}: seed {}, shard {shard} = instances {}..{} of {}{}",
@@ -362,11 +371,10 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
             )
         }
     );
-    if plan.scenario.randomise.is_empty() && !args.quiet {
-        eprintln!(
-            "warning: scenario {} randomises nothing: every instance is the same run",
-            plan.scenario.name
-        );
+    if let Some(warning) = mergesim::sweep::unrandomised_warning(&plan.scenario)
+        && !args.quiet
+    {
+        eprintln!("warning: {warning}");
     }
     let bar = if !args.quiet && std::io::stderr().is_terminal() {
         let bar = indicatif::ProgressBar::new(to_run);
@@ -403,7 +411,7 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
                 .store(true, std::sync::atomic::Ordering::Relaxed);
         }
     };
-    let outcome = run_sweep(&plan, &options, &on_run).map_err(sweep_failure)?;
+    let outcome = run_paired_sweep(&plan, &options, &on_run).map_err(sweep_failure)?;
     bar.finish_and_clear();
     if let Some(writer) = writer {
         let file = match writer.into_inner() {
@@ -424,22 +432,27 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
                 .unwrap_or_default()
         )));
     }
-    if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&outcome.summary).map_err(run_failure)?;
-        write_output(path, &text)?;
-    }
+    let report = outcome.report();
+    write_report(&report, args.json.as_deref(), args.parquet.as_deref())?;
     if !args.quiet {
-        out!("{}", outcome.summary.table());
-        for row in outcome.summary.samples.iter().filter(|r| r.error.is_some()) {
+        out!("{}", report.table());
+        let several = planner_count > 1;
+        for row in report.rows().into_iter().filter(|r| r.error.is_some()) {
             outln!(
-                "run {} (seed {}) {:?}: {}",
+                "run {}{} (seed {}) {:?}: {}",
                 row.instance,
+                if several {
+                    format!(" {}", row.planner)
+                } else {
+                    String::new()
+                },
                 row.seed,
                 row.status,
                 row.error.as_deref().unwrap_or_default()
             );
         }
     }
+    let finished: u64 = outcome.summaries.iter().map(|s| s.runs).sum();
     use mergesim::sweep::SweepVerdict;
     match outcome.verdict() {
         SweepVerdict::Complete => Ok(()),
@@ -448,8 +461,8 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
             &format!(
                 "{} of {} runs finished ({} in this attempt), {missing} missing; {}resume with \
                  the same command plus --resume{}",
-                outcome.summary.runs,
-                instances.end - instances.start,
+                finished,
+                expected_runs,
                 outcome.new_runs,
                 if args.json.is_some() {
                     "the --json aggregate covers the finished runs (missing_runs > 0); "
@@ -466,7 +479,7 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
         SweepVerdict::RunsFailed { failed, of } => Err(run_failure(anyhow!(
             "{failed} of {of} runs failed (panicked {}); their errors are listed above and in \
              the rows",
-            outcome.summary.panicked
+            outcome.summaries.iter().map(|s| s.panicked).sum::<u64>()
         ))),
     }
 }
@@ -513,26 +526,45 @@ fn open_jsonl(
     Ok(file)
 }
 
+/// Writes a sweep's report: the aggregate as JSON, the rows as Parquet.
+fn write_report(
+    report: &mergesim::sweep::SweepReport,
+    json: Option<&Path>,
+    parquet: Option<&Path>,
+) -> Result<(), Failure> {
+    if let Some(path) = json {
+        let text = report.to_json_pretty().map_err(run_failure)?;
+        write_output(path, &text)?;
+    }
+    if let Some(path) = parquet {
+        mergesim::sweep::parquet::write_parquet(path, report).map_err(run_failure)?;
+    }
+    Ok(())
+}
+
 pub(crate) fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> {
-    use mergesim::sweep::{SweepSummary, merge_shards};
+    use mergesim::sweep::{SweepReport, merge_reports};
     let inputs: Vec<&Path> = args.inputs.iter().map(PathBuf::as_path).collect();
-    check_outputs(&[(args.json.as_deref(), "--json")], &inputs)?;
+    check_outputs(
+        &[
+            (args.json.as_deref(), "--json"),
+            (args.parquet.as_deref(), "--parquet"),
+        ],
+        &inputs,
+    )?;
     let mut parts = Vec::with_capacity(args.inputs.len());
     for path in &args.inputs {
         let origin = path.display().to_string();
         let text = read_regular_text(path, MAX_RESULT_FILE_BYTES)
             .with_context(|| format!("cannot read {origin}"))
             .map_err(input)?;
-        let part: SweepSummary = serde_json::from_str(&text)
+        let part = SweepReport::from_json(&text)
             .with_context(|| format!("{origin}: not a `merge_sim sweep --json` file"))
             .map_err(input)?;
         parts.push((origin, part));
     }
-    let merged = merge_shards(parts).map_err(sweep_failure)?;
-    if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&merged).map_err(run_failure)?;
-        write_output(path, &text)?;
-    }
+    let merged = merge_reports(parts).map_err(sweep_failure)?;
+    write_report(&merged, args.json.as_deref(), args.parquet.as_deref())?;
     if !args.quiet {
         out!("{}", merged.table());
     }
