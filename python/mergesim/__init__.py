@@ -16,7 +16,7 @@ See python/README.md.
 from ._native import ScenarioError, SimulationError, builtin_scenarios, planners
 from .env import MergeEnv, RewardWeights
 from .run import RunResult, run
-from .sweep import paired_differences, sweep
+from .sweep import paired_differences, rows_frame, sweep
 
 __all__ = [
     "MergeEnv",
@@ -27,6 +27,7 @@ __all__ = [
     "builtin_scenarios",
     "paired_differences",
     "planners",
+    "rows_frame",
     "run",
     "sweep",
 ]

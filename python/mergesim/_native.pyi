@@ -18,13 +18,13 @@ def run(
 
 def sweep(
     scenario: str,
-    planners: Sequence[Optional[str]],
+    planners: Sequence[str],
     runs: int,
     seed: int,
     params_json: Optional[str] = None,
     threads: Optional[int] = None,
 ) -> List[str]:
-    """The JSONL rows of a sweep of every planner over the same instances."""
+    """The JSONL rows of a paired sweep of the planners (none: the scenario's own)."""
 
 def builtin_scenarios() -> List[str]:
     """Names of the built-in scenarios."""

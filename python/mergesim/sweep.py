@@ -15,20 +15,22 @@ _SEED_FIELDS = ("seed", "sweep_seed")
 
 
 def _flatten(prefix: str, value: Any, out: Dict[str, Any]) -> None:
-    """Nested dicts become ``a.b`` columns; a list of dicts with a ``name`` (the per-vehicle
-    figures) becomes ``vehicles.<name>.<field>`` columns; anything else is kept as it is."""
+    """Nested dicts become ``a.b`` columns (``drawn.sim.mu``); the per-vehicle figures (a list of
+    dicts with a ``name``) become ``<vehicle>.<figure>`` columns, as in ``merge_sim sweep
+    --parquet``; other lists become tuples."""
     if isinstance(value, Mapping):
         for key, inner in value.items():
             _flatten(f"{prefix}.{key}" if prefix else str(key), inner, out)
     elif (
         isinstance(value, list)
         and value
-        and all(isinstance(v, Mapping) and ("name" in v or "id" in v) for v in value)
+        and all(isinstance(v, Mapping) and "name" in v for v in value)
     ):
+        base = "" if prefix == "vehicles" else prefix
         for item in value:
-            label = item.get("name", item.get("id"))
-            rest = {k: v for k, v in item.items() if k not in ("name", "id")}
-            _flatten(f"{prefix}.{label}", rest, out)
+            label = str(item["name"])
+            rest = {k: v for k, v in item.items() if k != "name"}
+            _flatten(f"{base}.{label}" if base else label, rest, out)
     elif isinstance(value, list):
         out[prefix] = tuple(value)
     else:
@@ -36,9 +38,10 @@ def _flatten(prefix: str, value: Any, out: Dict[str, Any]) -> None:
 
 
 def rows_frame(lines: Iterable[str]) -> pd.DataFrame:
-    """The DataFrame of JSONL rows (``merge_sim sweep --jsonl``): one row per (instance,
-    planner), nested fields flattened (``drawn.<name>``, ``vehicles.<vehicle>.<figure>``), seeds
-    as unsigned 64-bit integers."""
+    """The DataFrame of JSONL rows (``merge_sim sweep --jsonl``): one row per line, nested fields
+    flattened as in ``merge_sim sweep --parquet`` (``drawn.<name>``, ``<vehicle>.<figure>``),
+    seeds as unsigned 64-bit integers. Reads a ``--jsonl`` file too:
+    ``rows_frame(open(path))``."""
     records: List[Dict[str, Any]] = []
     for line in lines:
         flat: Dict[str, Any] = {}
@@ -53,13 +56,14 @@ def rows_frame(lines: Iterable[str]) -> pd.DataFrame:
 
 def sweep(
     scenario: ScenarioSource,
-    planners: Sequence[Optional[str]] = (None,),
+    planners: Optional[Sequence[str]] = None,
     runs: int = 10,
     seed: int = 0,
     threads: Optional[int] = None,
     params: Optional[Mapping[str, Any]] = None,
 ) -> pd.DataFrame:
-    """Sweeps ``runs`` randomised instances of a scenario for each planner, in parallel in Rust.
+    """Sweeps ``runs`` randomised instances of a scenario for each planner, in parallel in Rust
+    (the library's paired sweep: what ``merge_sim sweep --planners A,B --jsonl`` runs).
 
     Instance ``i`` runs with seed ``instance_seed(seed, i)`` for every planner, so the planners
     meet the same drawn scenarios and the rows are paired by ``instance`` (and ``seed``); any
@@ -68,28 +72,32 @@ def sweep(
 
     Args:
         scenario: A built-in name, a path, or TOML text (as in :func:`mergesim.run`).
-        planners: Planner names (``mergesim.planners()``); None runs the scenario's own.
+        planners: Planner names (``mergesim.planners()``), the first the baseline; None (or an
+            empty list) runs the scenario's own planners once.
         runs: Instances per planner (1 to 1,000,000).
         seed: The sweep seed K (0 to 2**64-1).
         threads: Worker threads (None: one per core).
         params: Overrides merged over the scenario (as in :func:`mergesim.run`).
 
     Returns:
-        One row per (instance, planner), planner after planner, each in instance order, with
-        the columns of ``merge_sim sweep --jsonl`` rows: scenario, params, planner, instance,
-        seed, status, error (if any run failed), the run's figures (collisions, near_miss,
-        min_ttc_s, min_gap_m, tet_s, ...) and wall_time_s, nested fields flattened.
+        One row per (instance, planner), in instance order, the planners of an instance in the
+        given order, with the fields of ``merge_sim sweep --jsonl`` rows: scenario,
+        scenario_fingerprint, params, planners (the sweep's, a tuple), sweep_seed, total_runs,
+        instance, planner, seed, status, error (only if a run failed), ``drawn.<value>`` (what
+        the instance drew), the run's figures (collisions, near_miss, min_ttc_s, min_gap_m,
+        tet_s, peak_yaw_rate_radps, ...), ``<vehicle>.<figure>`` and wall_time_s.
 
     Raises:
         ScenarioError: Bad input (scenario, planner, runs, seed or threads).
     """
-    if isinstance(planners, str):
-        planners = [planners]
-    planner_list = list(planners)
-    if not planner_list:
-        raise ScenarioError("planners: give at least one planner")
+    if planners is None:
+        planner_list: List[str] = []
+    elif isinstance(planners, str):
+        planner_list = [planners]
+    else:
+        planner_list = list(planners)
     for name in planner_list:
-        if name is not None and not isinstance(name, str):
+        if not isinstance(name, str):
             raise ScenarioError(f"planners: {name!r} is not a planner name")
     lines = _native.sweep(
         scenario_arg(scenario),

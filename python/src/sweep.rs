@@ -1,73 +1,70 @@
-//! `mergesim.sweep`: seeded Monte-Carlo sweeps of one or several planners over the same
-//! instances (paired by seed), run in parallel by the library's sweep (`mergesim::sweep`).
+//! `mergesim.sweep`: a seeded Monte-Carlo sweep of one or several planners over the same
+//! instances (paired by seed), run in parallel by the library (`mergesim::sweep`'s paired sweep,
+//! what `merge_sim sweep --planners` runs).
 
-use mergesim::sweep::{Shard, SweepIdentity, SweepOptions, SweepPlan, jsonl_line, run_sweep};
+use mergesim::sweep::{
+    PairedSweepPlan, Shard, SweepError, SweepIdentity, SweepOptions, jsonl_line, run_paired_sweep,
+};
 use planner::PlannerKind;
 use pyo3::prelude::*;
 
 use crate::errors::BindingError;
 use crate::source;
 
-/// Sweeps `runs` instances drawn with sweep seed `seed` for every planner of `planners` (`None`:
-/// the scenario's own); returns the JSONL rows (`merge_sim sweep --jsonl`), planner after
-/// planner, each in instance order. Instance `i` has the same seed, so the same drawn scenario,
-/// for every planner. The GIL is released while the sweeps run.
+/// Sweeps `runs` instances drawn with sweep seed `seed` for every planner of `planners` (empty:
+/// the scenario's own); returns the JSONL rows (`merge_sim sweep --jsonl`) in instance order,
+/// the planners of an instance in the given order. Instance `i` has the same seed, so the same
+/// drawn scenario, for every planner. The GIL is released while the sweep runs.
 #[pyfunction]
 #[pyo3(signature = (scenario, planners, runs, seed, params_json = None, threads = None))]
 pub fn sweep(
     py: Python<'_>,
     scenario: &str,
-    planners: Vec<Option<String>>,
+    planners: Vec<String>,
     runs: u64,
     seed: u64,
     params_json: Option<&str>,
     threads: Option<usize>,
 ) -> PyResult<Vec<String>> {
     let scenario = source::load(scenario, params_json)?;
-    if planners.is_empty() {
-        return Err(BindingError::Input("planners: give at least one planner".into()).into());
-    }
-    let kinds = planners
+    let planners = planners
         .iter()
-        .map(|name| {
-            name.as_deref()
-                .map(|n| n.parse::<PlannerKind>())
-                .transpose()
-                .map_err(|e| BindingError::input(&e))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+        .map(|name| name.parse::<PlannerKind>())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| BindingError::input(&e))?;
+    let plan = PairedSweepPlan {
+        scenario,
+        planners,
+        runs,
+        seed,
+        shard: Shard::WHOLE,
+    };
     let options = SweepOptions {
         threads,
         ..SweepOptions::default()
     };
-    let lines = py.detach(|| -> Result<Vec<String>, BindingError> {
-        let mut lines = Vec::new();
-        for planner in kinds {
-            let plan = SweepPlan {
-                scenario: scenario.clone(),
-                planner,
-                runs,
-                seed,
-                shard: Shard::WHOLE,
-            };
-            let outcome = run_sweep(&plan, &options, &|_| {}).map_err(|e| match e {
-                mergesim::sweep::SweepError::Invalid(_) => BindingError::input(&e),
-                mergesim::sweep::SweepError::Threads(_) => BindingError::run(&e),
-            })?;
-            let identity = SweepIdentity::of(&plan);
-            for (row, wall_time_s) in outcome
-                .summary
-                .samples
-                .iter()
-                .zip(&outcome.run_wall_times_s)
-            {
-                lines.push(
-                    jsonl_line(&identity, row, *wall_time_s)
-                        .map_err(|e| BindingError::Run(format!("cannot encode a row: {e}")))?,
-                );
-            }
+    let outcome = py
+        .detach(|| run_paired_sweep(&plan, &options, &|_| {}))
+        .map_err(|e| match e {
+            SweepError::Threads(_) => BindingError::run(&e),
+            SweepError::Invalid(_) => BindingError::input(&e),
+        })?;
+    // The sweep's identity (all its planners), as the CLI writes it on every line.
+    let identity = SweepIdentity::of_paired(&plan);
+    // (instance, planner index, line), sorted by instance then the plan's planner order.
+    let mut lines = Vec::new();
+    for (index, (summary, wall_times_s)) in outcome
+        .summaries
+        .iter()
+        .zip(&outcome.run_wall_times_s)
+        .enumerate()
+    {
+        for (row, wall_time_s) in summary.samples.iter().zip(wall_times_s) {
+            let line = jsonl_line(&identity, row, *wall_time_s)
+                .map_err(|e| BindingError::Run(format!("cannot encode a row: {e}")))?;
+            lines.push((row.instance, index, line));
         }
-        Ok(lines)
-    })?;
-    Ok(lines)
+    }
+    lines.sort_by_key(|(instance, index, _)| (*instance, *index));
+    Ok(lines.into_iter().map(|(_, _, line)| line).collect())
 }

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import pathlib
+import subprocess
+
 import pandas as pd
 import pytest
 
@@ -17,6 +20,22 @@ def rows() -> pd.DataFrame:
     return mergesim.sweep("urgent_merge", planners=PLANNERS, runs=3, seed=11, params=SHORT, threads=2)
 
 
+def test_rows_equal_the_cli_jsonl(merge_sim: str, short_urgent_merge: pathlib.Path, tmp_path: pathlib.Path) -> None:
+    jsonl = tmp_path / "rows.jsonl"
+    subprocess.run(
+        [merge_sim, "sweep", "--scenario", str(short_urgent_merge), "--planners", ",".join(PLANNERS),
+         "--runs", "3", "--seed", "11", "--quiet", "--jsonl", str(jsonl)],
+        check=True,
+    )
+    cli = mergesim.rows_frame(jsonl.read_text().splitlines())
+    ours = mergesim.sweep(short_urgent_merge, planners=PLANNERS, runs=3, seed=11)
+    cli = cli.sort_values(["instance", "planner"]).reset_index(drop=True)
+    assert list(ours.columns) == list(cli.columns)
+    pd.testing.assert_frame_equal(
+        ours.drop(columns="wall_time_s").reset_index(drop=True), cli.drop(columns="wall_time_s")
+    )
+
+
 def test_one_row_per_instance_and_planner(rows: pd.DataFrame) -> None:
     assert len(rows) == 6
     assert sorted(set(rows["planner"])) == PLANNERS
@@ -25,6 +44,9 @@ def test_one_row_per_instance_and_planner(rows: pd.DataFrame) -> None:
     for column in ["seed", "collisions", "min_gap_m", "tet_s", "near_miss", "wall_time_s"]:
         assert column in rows.columns, column
     assert rows["seed"].dtype == "uint64"
+    assert {"drawn.sim.mu", "ego.min_speed_mps", "obstacle.collided"} <= set(rows.columns)
+    assert list(rows["instance"]) == [0, 0, 1, 1, 2, 2]
+    assert list(rows["planner"]) == PLANNERS * 3
 
 
 def test_planners_meet_the_same_instances(rows: pd.DataFrame) -> None:
