@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# The Python package in CI: install it (after `cargo test --release --workspace`, this compiles
+# only pyo3 and the bindings) and run its tests against the merge_sim built by cargo test.
+set -euo pipefail
+cd "$(dirname "$0")"
+pip=(python3 -m pip install --quiet --disable-pip-version-check)
+"${pip[@]}" "maturin>=1.9,<2" numpy pandas gymnasium pytest matplotlib
+# No build isolation: the maturin just installed builds it (no second download).
+started=$SECONDS
+"${pip[@]}" --no-build-isolation .
+echo "pip install ./python: $((SECONDS - started)) s"
+# From tests/, so that the installed package is imported, not the sources beside it.
+cd tests
+MERGESIM_BIN="${MERGESIM_BIN:-$PWD/../../target/release/merge_sim}" python3 -m pytest -q -p no:cacheprovider
