@@ -3,7 +3,7 @@
 # only pyo3 and the bindings) and run its tests against the merge_sim built by cargo test.
 set -euo pipefail
 cd "$(dirname "$0")"
-pip=(python3 -m pip install --quiet --disable-pip-version-check)
+pip=(python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore)
 "${pip[@]}" "maturin>=1.9,<2" numpy pandas gymnasium pytest matplotlib
 # No build isolation: the maturin just installed builds it (no second download).
 started=$SECONDS

@@ -38,19 +38,25 @@ def params_json(params: Optional[Mapping[str, Any]]) -> Optional[str]:
         raise ScenarioError(f"params: {e}") from None
 
 
-def seed_arg(name: str, seed: Optional[int], optional: bool = True) -> Optional[int]:
-    """A seed: an integer in 0..2**64-1 (None if optional)."""
-    if seed is None and optional:
-        return None
+def seed_arg(name: str, seed: object) -> int:
+    """A seed: an integer in 0..2**64-1."""
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= _U64_MAX:
         raise ScenarioError(f"{name} = {seed!r}: need an integer from 0 to {_U64_MAX}")
     return int(seed)
 
 
-def count_arg(name: str, value: Optional[int], optional: bool = False) -> Optional[int]:
-    """A positive integer (None if optional)."""
-    if value is None and optional:
-        return None
+def optional_seed_arg(name: str, seed: object) -> Optional[int]:
+    """None or a seed (:func:`seed_arg`)."""
+    return None if seed is None else seed_arg(name, seed)
+
+
+def count_arg(name: str, value: object) -> int:
+    """A positive integer."""
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         raise ScenarioError(f"{name} = {value!r}: need a positive integer")
     return int(value)
+
+
+def optional_count_arg(name: str, value: object) -> Optional[int]:
+    """None or a positive integer (:func:`count_arg`)."""
+    return None if value is None else count_arg(name, value)

@@ -103,7 +103,7 @@ class MergeEnv(gym.Env):
                 f"render_mode {render_mode!r}: not one of {self.metadata['render_modes']}"
             )
         self._core = _native.EnvCore(scenario_arg(scenario), params_json(params), planner, vehicle)
-        self._k = int(count_arg("neighbours", neighbours))  # type: ignore[arg-type]
+        self._k = count_arg("neighbours", neighbours)
         self._randomise = bool(randomise)
         self.reward_weights = reward_weights
         self.render_mode = render_mode
@@ -115,13 +115,13 @@ class MergeEnv(gym.Env):
         self.metadata = {**self.metadata, "render_fps": round(1.0 / self.period_s)}
         lane_width_m = self.road["lane_width_m"]
         max_speed_mps = 1.5 * float(self._core.nominal_target_speed_mps)
-        self.action_space = spaces.Box(
+        self.action_space: spaces.Box = spaces.Box(
             low=np.array([0.0, -1.5 * lane_width_m], dtype=np.float32),
             high=np.array([max_speed_mps, 0.5 * lane_width_m], dtype=np.float32),
             dtype=np.float32,
         )
         size = len(EGO_FIELDS) + len(NEIGHBOUR_FIELDS) * self._k
-        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(size,), dtype=np.float32)
+        self.observation_space: spaces.Box = spaces.Box(-np.inf, np.inf, shape=(size,), dtype=np.float32)
         self._states = np.zeros((len(self.vehicle_names), 9))
         self._previous_accel_mps2 = 0.0
         self._time_s = 0.0
@@ -162,7 +162,8 @@ class MergeEnv(gym.Env):
             dy = others[:, _Y] - me[_Y]
             distance = np.hypot(dx, dy)
             # Nearest first; ties by id order (a stable sort), so the order is deterministic.
-            order = [i for i in np.argsort(distance, kind="stable") if distance[i] <= PERCEPTION_RANGE_M]
+            nearest = np.argsort(distance, kind="stable")
+            order = [i for i in nearest if distance[i] <= PERCEPTION_RANGE_M]
             for row, i in enumerate(order[: self._k]):
                 rel[row] = (
                     1.0,
@@ -210,7 +211,11 @@ class MergeEnv(gym.Env):
         """
         if self._over:
             raise _native.ScenarioError("step after the episode ended: call reset() first")
-        a = np.clip(np.asarray(action, dtype=np.float64).reshape(2), self.action_space.low, self.action_space.high)
+        a = np.clip(
+            np.asarray(action, dtype=np.float64).reshape(2),
+            self.action_space.low,
+            self.action_space.high,
+        )
         if not np.all(np.isfinite(a)):
             raise _native.ScenarioError(f"action {action!r}: must be finite")
         x_before = self._states[self.agent, _X]
@@ -234,9 +239,11 @@ class MergeEnv(gym.Env):
         )
         length_m = self._sizes_m[self.agent][0]
         front_m = me[_X] + 0.5 * length_m
-        end_reached = (road_end == self.vehicle_names[self.agent]) or front_m >= self.road[
-            "end_x_m"
-        ] - ROAD_END_MARGIN_M - 2.0 * me[_SPEED] * self.period_s
+        end_margin_m = ROAD_END_MARGIN_M + 2.0 * me[_SPEED] * self.period_s
+        end_reached = bool(
+            road_end == self.vehicle_names[self.agent]
+            or front_m >= self.road["end_x_m"] - end_margin_m
+        )
         terminated = bool(hit_vehicle or hit_edge or end_reached or error is not None)
         truncated = bool(
             not terminated

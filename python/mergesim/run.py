@@ -10,7 +10,7 @@ from typing import Any, Dict, Mapping, Optional
 import pandas as pd
 
 from . import _native
-from ._common import ScenarioSource, params_json, scenario_arg, seed_arg
+from ._common import ScenarioSource, optional_seed_arg, params_json, scenario_arg
 
 
 @dataclass(frozen=True)
@@ -60,6 +60,6 @@ def run(
         scenario_arg(scenario),
         params_json(params),
         planner,
-        seed_arg("seed", seed),
+        optional_seed_arg("seed", seed),
     )
     return RunResult(summary=json.loads(summary), time_series=pd.read_csv(io.StringIO(csv)))

@@ -8,7 +8,15 @@ from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence
 import pandas as pd
 
 from . import _native
-from ._common import ScenarioError, ScenarioSource, count_arg, params_json, scenario_arg, seed_arg
+from ._common import (
+    ScenarioError,
+    ScenarioSource,
+    count_arg,
+    optional_count_arg,
+    params_json,
+    scenario_arg,
+    seed_arg,
+)
 
 #: Row fields that hold a 64-bit seed, written as strings in the JSONL (exact in every reader).
 _SEED_FIELDS = ("seed", "sweep_seed")
@@ -103,9 +111,9 @@ def sweep(
         scenario_arg(scenario),
         planner_list,
         count_arg("runs", runs),
-        seed_arg("seed", seed, optional=False),
+        seed_arg("seed", seed),
         params_json(params),
-        count_arg("threads", threads, optional=True),
+        optional_count_arg("threads", threads),
     )
     return rows_frame(lines)
 
