@@ -44,7 +44,7 @@ PERCEPTION_RANGE_M = 250.0
 #: Margin before the road's end at which the episode ends (m, plus two steps of travel).
 ROAD_END_MARGIN_M = 1.0
 
-_X, _Y, _YAW, _SPEED, _VX, _VY, _YAW_RATE, _ACCEL_LONG = range(8)
+_X, _Y, _YAW, _SPEED, _VX, _VY, _YAW_RATE = range(7)
 
 
 @dataclass(frozen=True)
@@ -53,15 +53,15 @@ class RewardWeights:
 
     Attributes:
         progress: Per step, times the distance travelled over the distance at the target speed.
-        jerk: Times the squared longitudinal jerk (m/s³)², jerk from the change of acceleration
-            over the step.
+        jerk: Times the squared longitudinal jerk (m/s³)²: the change over the step of the mean
+            acceleration over the step (the change of speed / period).
         yaw_rate: Times the squared yaw rate (rad/s)².
         collision: Subtracted when the agent collides with another vehicle (ends the episode).
         road_edge: Subtracted when the agent touches a road edge (ends the episode).
     """
 
     progress: float = 0.1
-    jerk: float = 0.002
+    jerk: float = 0.001
     yaw_rate: float = 0.5
     collision: float = 10.0
     road_edge: float = 10.0
@@ -123,7 +123,9 @@ class MergeEnv(gym.Env):
         size = len(EGO_FIELDS) + len(NEIGHBOUR_FIELDS) * self._k
         self.observation_space: spaces.Box = spaces.Box(-np.inf, np.inf, shape=(size,), dtype=np.float32)
         self._states = np.zeros((len(self.vehicle_names), 9))
-        self._previous_accel_mps2 = 0.0
+        # Mean longitudinal acceleration over the last step (m/s²): the change of speed over the
+        # period, steadier than the physics step's own.
+        self._accel_mps2 = 0.0
         self._time_s = 0.0
         self._over = True
 
@@ -149,7 +151,7 @@ class MergeEnv(gym.Env):
             me[_Y] - self._through_lane_y_m(),
             me[_YAW],
             me[_YAW_RATE],
-            me[_ACCEL_LONG],
+            self._accel_mps2,
             road["merge_end_x_m"] - me[_X],
             road["end_x_m"] - me[_X],
             road["y_bottom_m"] + 2.0 * road["lane_width_m"] - me[_Y],
@@ -194,7 +196,7 @@ class MergeEnv(gym.Env):
             instance_seed = int(self.np_random.integers(0, 2**63))
         self._states = np.asarray(self._core.reset(instance_seed), dtype=np.float64)
         self.road = dict(self._core.road)
-        self._previous_accel_mps2 = float(self._states[self.agent, _ACCEL_LONG])
+        self._accel_mps2 = 0.0
         self._time_s = 0.0
         self._over = False
         info = {"time_s": 0.0, "instance_seed": instance_seed}
@@ -219,6 +221,7 @@ class MergeEnv(gym.Env):
         if not np.all(np.isfinite(a)):
             raise _native.ScenarioError(f"action {action!r}: must be finite")
         x_before = self._states[self.agent, _X]
+        speed_before_mps = self._states[self.agent, _SPEED]
         states, hit_vehicle, hit_edge, road_end, error, time_s = self._core.step(
             float(a[0]), float(a[1]) + self._through_lane_y_m()
         )
@@ -228,8 +231,9 @@ class MergeEnv(gym.Env):
         w = self.reward_weights
         target_mps = max(float(self._core.agent_target_speed_mps), 0.1)
         progress = (me[_X] - x_before) / (target_mps * self.period_s)
-        jerk_mps3 = (me[_ACCEL_LONG] - self._previous_accel_mps2) / self.period_s
-        self._previous_accel_mps2 = float(me[_ACCEL_LONG])
+        accel_mps2 = (me[_SPEED] - speed_before_mps) / self.period_s
+        jerk_mps3 = (accel_mps2 - self._accel_mps2) / self.period_s
+        self._accel_mps2 = float(accel_mps2)
         reward = (
             w.progress * progress
             - w.jerk * jerk_mps3**2
