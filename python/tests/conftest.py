@@ -28,7 +28,8 @@ def merge_sim_binary() -> Optional[str]:
 def merge_sim() -> str:
     binary = merge_sim_binary()
     if binary is None:
-        pytest.skip("merge_sim not built (cargo build --release)")
+        # A failure, not a skip: these comparisons are the point of the tests.
+        pytest.fail("merge_sim not found: build it (cargo build --release) or set MERGESIM_BIN")
     return binary
 
 
@@ -38,6 +39,7 @@ def short_urgent_merge(tmp_path: pathlib.Path) -> pathlib.Path:
     import mergesim._native as native  # noqa: F401  (the package must import)
 
     text = (REPO / "scenarios" / "builtin" / "urgent_merge.toml").read_text()
+    assert "duration_s = 25.0" in text, "urgent_merge.toml no longer says duration_s = 25.0"
     text = text.replace("duration_s = 25.0", "duration_s = 2.0")
     path = tmp_path / "short.toml"
     path.write_text(text)
