@@ -152,3 +152,36 @@ fn planned_speed_does_not_chatter_between_planning_cycles() {
     let lowest = planned.iter().cloned().fold(f64::INFINITY, f64::min);
     assert!(lowest < 14.5, "{lowest}");
 }
+
+/// `World::plan_on`: planning on a pool the caller gives (the Python environment's one-thread
+/// pool) changes no bit.
+#[test]
+fn planning_on_a_given_pool_gives_the_same_bits() {
+    use mergesim::sim::recording::Recorder;
+    use mergesim::sim::{RunOptions, World};
+    let mut scenario = Scenario::load("dense_merge").unwrap();
+    scenario.randomise = Default::default();
+    let reference = run(&scenario, None, true);
+    let instance = scenario.instance(Some(0));
+    let options = RunOptions {
+        planner_override: None,
+        seed: 0,
+        keep_time_series: true,
+        profile: false,
+    };
+    let mut world = World::new(
+        instance.sim,
+        &instance.vehicles,
+        &options,
+        Recorder::disabled(),
+    )
+    .unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .stack_size(16 << 20)
+        .build()
+        .unwrap();
+    world.plan_on(std::sync::Arc::new(pool));
+    let on_pool = world.run(|_| {}).unwrap();
+    assert_bitwise_equal(&reference, &on_pool);
+}

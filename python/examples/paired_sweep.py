@@ -32,22 +32,44 @@ metrics = {
     "min_speed_mps": "lowest speed of any vehicle (m/s)",
 }
 differences = {m: mergesim.paired_differences(rows, m, BASELINE, OTHER) for m in metrics}
-for metric, diff in differences.items():
-    se = diff.std(ddof=1) / len(diff) ** 0.5 if len(diff) > 1 else float("nan")
-    print(f"{metric}: mean {OTHER} − {BASELINE} = {diff.mean():+.3f} ± {se:.3f} (n = {len(diff)})")
+import numpy as np  # noqa: E402
 
-# %% Plot: per metric, the baseline against the other planner, one point per instance.
+
+def mean_and_se(diff):
+    """Mean ± standard error of the finite differences (as merge_sim sweep reports them)."""
+    finite = diff[np.isfinite(diff)]
+    se = finite.std(ddof=1) / len(finite) ** 0.5 if len(finite) > 1 else float("nan")
+    return finite.mean(), se, len(finite)
+
+
+for metric, diff in differences.items():
+    mean, se, n = mean_and_se(diff)
+    print(f"{metric}: mean {OTHER} − {BASELINE} = {mean:+.3g} ± {se:.2g} (n = {n}); "
+          f"{OTHER} higher in {(diff > 0).sum()}, lower in {(diff < 0).sum()}")
+
+# %% Plot: per metric, the paired difference of every instance, with the mean ± 2 SE. The y range
+# is the central 90 % of the differences (widened to hold the mean's band), so one outlier does
+# not flatten the rest; how many fall outside is written in the panel.
 fig, axes = plt.subplots(1, len(metrics), figsize=(4.2 * len(metrics), 4))
-done = rows[rows["status"] == "completed"]
 for ax, (metric, label) in zip(axes, metrics.items()):
-    table = done.pivot(index="instance", columns="planner", values=metric).astype(float).dropna()
-    ax.scatter(table[BASELINE], table[OTHER], s=14, alpha=0.8)
-    low = min(table[BASELINE].min(), table[OTHER].min())
-    high = max(table[BASELINE].max(), table[OTHER].max())
-    ax.plot([low, high], [low, high], color="grey", lw=0.8, ls="--")
-    ax.set_xlabel(f"{BASELINE}")
-    ax.set_ylabel(f"{OTHER}")
-    ax.set_title(f"{label}\nmean Δ = {differences[metric].mean():+.3f}", fontsize=9)
+    diff = differences[metric]
+    finite = diff[np.isfinite(diff)]
+    mean, se, n = mean_and_se(diff)
+    ax.axhline(0.0, color="grey", lw=0.8, ls="--")
+    ax.scatter(finite.index, finite.values, s=14, alpha=0.8)
+    ax.axhspan(mean - 2 * se, mean + 2 * se, color="tab:orange", alpha=0.25, label="mean ± 2 SE")
+    ax.axhline(mean, color="tab:orange", lw=1.2)
+    low, high = np.nanpercentile(finite, [5, 95]) if n else (0.0, 0.0)
+    low, high = min(low, mean - 2 * se, 0.0), max(high, mean + 2 * se, 0.0)
+    pad = 0.1 * (high - low) if high > low else 1e-6
+    ax.set_ylim(low - pad, high + pad)
+    outside = int(((finite < low - pad) | (finite > high + pad)).sum())
+    if outside:
+        ax.text(0.02, 0.02, f"{outside} outside the range shown", transform=ax.transAxes, fontsize=8)
+    ax.set_xlabel("instance")
+    ax.set_ylabel(f"{OTHER} − {BASELINE}")
+    ax.set_title(f"{label}\nmean Δ = {mean:+.3g} ± {se:.2g} (SE)", fontsize=9)
+    ax.legend(loc="best", fontsize=8)
 fig.suptitle(f"urgent_merge, {RUNS} paired instances (seed 2024)")
 fig.tight_layout()
 fig.savefig(OUT, dpi=120)

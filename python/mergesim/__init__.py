@@ -18,7 +18,15 @@ from .env import MergeEnv, RewardWeights
 from .run import RunResult, run
 from .sweep import paired_differences, rows_frame, sweep
 
+try:
+    from importlib.metadata import version as _version
+
+    __version__ = _version("mergesim")
+except Exception:  # not installed (e.g. imported from the source tree)
+    __version__ = "0+unknown"
+
 __all__ = [
+    "__version__",
     "MergeEnv",
     "RewardWeights",
     "RunResult",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import operator
 import os
 from typing import Any, Mapping, Optional, Union
 
@@ -38,11 +39,22 @@ def params_json(params: Optional[Mapping[str, Any]]) -> Optional[str]:
         raise ScenarioError(f"params: {e}") from None
 
 
+def _integer(value: object) -> Optional[int]:
+    """`value` as a Python int if it is an integer (int, numpy.uint64, ...; not a bool)."""
+    if isinstance(value, bool):
+        return None
+    try:
+        return operator.index(value)  # type: ignore[call-overload]
+    except TypeError:
+        return None
+
+
 def seed_arg(name: str, seed: object) -> int:
-    """A seed: an integer in 0..2**64-1."""
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= _U64_MAX:
+    """A seed: an integer in 0..2**64-1 (numpy integers too, e.g. a sweep row's ``seed``)."""
+    value = _integer(seed)
+    if value is None or not 0 <= value <= _U64_MAX:
         raise ScenarioError(f"{name} = {seed!r}: need an integer from 0 to {_U64_MAX}")
-    return int(seed)
+    return value
 
 
 def optional_seed_arg(name: str, seed: object) -> Optional[int]:
@@ -51,10 +63,11 @@ def optional_seed_arg(name: str, seed: object) -> Optional[int]:
 
 
 def count_arg(name: str, value: object) -> int:
-    """A positive integer."""
-    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+    """A positive integer (numpy integers too)."""
+    number = _integer(value)
+    if number is None or number < 1:
         raise ScenarioError(f"{name} = {value!r}: need a positive integer")
-    return int(value)
+    return number
 
 
 def optional_count_arg(name: str, value: object) -> Optional[int]:

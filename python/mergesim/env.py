@@ -56,6 +56,8 @@ class RewardWeights:
         jerk: Times the squared longitudinal jerk (m/s³)²: the change over the step of the mean
             acceleration over the step (the change of speed / period).
         yaw_rate: Times the squared yaw rate (rad/s)².
+        comfort_cap: Largest comfort penalty (jerk + yaw-rate terms) of one step: an impact's
+            jerk (hundreds of m/s³) must not outweigh the collision penalty itself.
         collision: Subtracted when the agent collides with another vehicle (ends the episode).
         road_edge: Subtracted when the agent touches a road edge (ends the episode).
     """
@@ -63,6 +65,7 @@ class RewardWeights:
     progress: float = 0.1
     jerk: float = 0.001
     yaw_rate: float = 0.5
+    comfort_cap: float = 1.0
     collision: float = 10.0
     road_edge: float = 10.0
 
@@ -105,6 +108,11 @@ class MergeEnv(gym.Env):
         self._core = _native.EnvCore(scenario_arg(scenario), params_json(params), planner, vehicle)
         self._k = count_arg("neighbours", neighbours)
         self._randomise = bool(randomise)
+        if not isinstance(reward_weights, RewardWeights):
+            raise _native.ScenarioError(
+                "reward_weights: must be a mergesim.RewardWeights, e.g. RewardWeights(jerk=0.0),"
+                f" got {type(reward_weights).__name__}"
+            )
         self.reward_weights = reward_weights
         self.render_mode = render_mode
         self.agent = self._core.agent_index
@@ -212,7 +220,9 @@ class MergeEnv(gym.Env):
         centre of the ending lane).
         """
         if self._over:
-            raise _native.ScenarioError("step after the episode ended: call reset() first")
+            raise _native.ScenarioError(
+                "step before reset() or after the episode ended: call reset() first"
+            )
         a = np.clip(
             np.asarray(action, dtype=np.float64).reshape(2),
             self.action_space.low,
@@ -234,10 +244,10 @@ class MergeEnv(gym.Env):
         accel_mps2 = (me[_SPEED] - speed_before_mps) / self.period_s
         jerk_mps3 = (accel_mps2 - self._accel_mps2) / self.period_s
         self._accel_mps2 = float(accel_mps2)
+        comfort = min(w.jerk * jerk_mps3**2 + w.yaw_rate * me[_YAW_RATE] ** 2, w.comfort_cap)
         reward = (
             w.progress * progress
-            - w.jerk * jerk_mps3**2
-            - w.yaw_rate * me[_YAW_RATE] ** 2
+            - comfort
             - (w.collision if hit_vehicle else 0.0)
             - (w.road_edge if hit_edge else 0.0)
         )

@@ -21,6 +21,21 @@ from ._common import (
 #: Row fields that hold a 64-bit seed, written as strings in the JSONL (exact in every reader).
 _SEED_FIELDS = ("seed", "sweep_seed")
 
+#: Run-level figures whose ``null`` in a row means +∞ (no pair ever came within range / was
+#: ever closing), as ``merge_sim sweep`` counts them in its paired differences.
+INFINITE_WHEN_NULL = ("min_gap_m", "min_ttc_s")
+#: Per-vehicle figures (``<vehicle>.<figure>``) whose ``null`` means +∞ (never slowed, never
+#: crossed the lane divider).
+VEHICLE_INFINITE_WHEN_NULL = ("slowing_onset_s", "divider_crossing_t_s")
+
+
+def _infinite_when_null(column: str) -> bool:
+    if column in INFINITE_WHEN_NULL:
+        return True
+    return "." in column and not column.startswith("drawn.") and (
+        column.rsplit(".", 1)[1] in VEHICLE_INFINITE_WHEN_NULL
+    )
+
 
 def _flatten(prefix: str, value: Any, out: Dict[str, Any]) -> None:
     """Nested dicts become ``a.b`` columns (``drawn.sim.mu``); the per-vehicle figures (a list of
@@ -48,7 +63,10 @@ def _flatten(prefix: str, value: Any, out: Dict[str, Any]) -> None:
 def rows_frame(lines: Iterable[str]) -> pd.DataFrame:
     """The DataFrame of JSONL rows (``merge_sim sweep --jsonl``): one row per line, nested fields
     flattened as in ``merge_sim sweep --parquet`` (``drawn.<name>``, ``<vehicle>.<figure>``),
-    seeds as unsigned 64-bit integers. Reads a ``--jsonl`` file too:
+    seeds as unsigned 64-bit integers. A ``null`` that means +∞ (``min_gap_m`` and ``min_ttc_s``
+    when no pair came within range or closed; a vehicle's ``slowing_onset_s`` and
+    ``divider_crossing_t_s`` when it never slowed or crossed) is ``inf`` in a completed run's
+    row, so means and quantiles keep those runs. Reads a ``--jsonl`` file too:
     ``rows_frame(open(path))``."""
     records: List[Dict[str, Any]] = []
     for line in lines:
@@ -56,6 +74,13 @@ def rows_frame(lines: Iterable[str]) -> pd.DataFrame:
         _flatten("", json.loads(line), flat)
         records.append(flat)
     frame = pd.DataFrame.from_records(records)
+    completed = frame["status"] == "completed" if "status" in frame.columns else None
+    for column in frame.columns:
+        if completed is not None and _infinite_when_null(column):
+            # +inf, not NaN: pandas would leave NaN out of means and quantiles, i.e. drop the
+            # safest runs. Only completed runs (a failed run has no figures at all).
+            values = frame[column].astype(float)
+            frame[column] = values.where(~(values.isna() & completed), float("inf"))
     for field in _SEED_FIELDS:
         if field in frame.columns:
             frame[field] = frame[field].map(int).astype("uint64")
@@ -80,8 +105,9 @@ def sweep(
 
     Args:
         scenario: A built-in name, a path, or TOML text (as in :func:`mergesim.run`).
-        planners: Planner names (``mergesim.planners()``), the first the baseline; None (or an
-            empty list) runs the scenario's own planners once.
+        planners: Planner names (``mergesim.planners()``), the first the baseline, as a list or
+            a comma-separated string (as ``--planners``); None (or an empty list) runs the
+            scenario's own planners once.
         runs: Instances per planner (1 to 1,000,000).
         seed: The sweep seed K (0 to 2**64-1).
         threads: Worker threads (None: one per core).
@@ -101,7 +127,8 @@ def sweep(
     if planners is None:
         planner_list: List[str] = []
     elif isinstance(planners, str):
-        planner_list = [planners]
+        # As on the command line: "pf-cs,pf-iso" is two planners.
+        planner_list = [name.strip() for name in planners.split(",")]
     else:
         planner_list = list(planners)
     for name in planner_list:
@@ -121,7 +148,13 @@ def sweep(
 def paired_differences(
     rows: pd.DataFrame, metric: str, baseline: str, other: str
 ) -> pd.Series:
-    """``other − baseline`` of ``metric`` per instance, over the instances both completed.
+    """``other − baseline`` of ``metric`` per instance, over the instances both completed (and,
+    for a ``<vehicle>.<figure>``, where both have a value).
+
+    A figure that is +∞ in both rows (e.g. ``min_ttc_s`` when no pair ever closed with either
+    planner) gives 0 (a tie, as ``merge_sim sweep`` counts it); +∞ in one gives ±∞. So
+    ``(d > 0).sum()``, ``(d < 0).sum()`` and ``(d == 0).sum()`` are the CLI's higher / lower /
+    tied counts, and the CLI's mean difference ± SE is that of the finite differences.
 
     Args:
         rows: What :func:`sweep` returned (with both planners).
@@ -139,5 +172,12 @@ def paired_differences(
     for name in (baseline, other):
         if name not in table.columns:
             raise ScenarioError(f"planner {name!r}: not among the rows' planners")
-    both = table[[baseline, other]].astype(float).dropna()
-    return (both[other] - both[baseline]).rename(f"{metric} {other} - {baseline}")
+    if baseline == other:
+        raise ScenarioError(f"baseline and other are the same planner {baseline!r}")
+    try:
+        both = table[[baseline, other]].astype(float).dropna()
+    except (TypeError, ValueError):
+        raise ScenarioError(f"metric {metric!r}: not a numeric column") from None
+    both_infinite = (both[other] == float("inf")) & (both[baseline] == float("inf"))
+    difference = (both[other] - both[baseline]).where(~both_infinite, 0.0)
+    return difference.rename(f"{metric} {other} - {baseline}")

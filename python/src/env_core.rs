@@ -131,14 +131,10 @@ impl EnvCore {
             None => names.iter().position(|n| *n == "ego").unwrap_or(0),
         };
         let registry = BehaviourRegistry::builtin();
-        if let Some(name) = &planner
-            && !registry.contains(name)
-        {
-            return Err(BindingError::Input(format!(
-                "planner {name:?}: not a planner ({})",
-                registry.names().join(", ")
-            ))
-            .into());
+        // Checked as `merge_sim run --planner` checks it (the same message).
+        if let Some(name) = &planner {
+            name.parse::<planner::PlannerKind>()
+                .map_err(|e| BindingError::input(&e))?;
         }
         let command: SharedCommand = Arc::new(Mutex::new(Command {
             target_speed_mps: scenario.vehicles[agent].target_speed_mps,
@@ -207,6 +203,10 @@ impl EnvCore {
             &self.registry,
         )
         .map_err(|e| BindingError::input(&e))?;
+        // A one-thread pool created at every reset, in the current process: an environment
+        // in a forked child (`AsyncVectorEnv`) never waits on threads the fork did not copy,
+        // and vector environments do not oversubscribe the cores (`background`).
+        world.plan_on(crate::background::fresh_pool(Some(1))?);
         world.add_observer(Box::new(ContactWatch {
             agent: self.agent as VehicleId,
             contacts: self.contacts.clone(),

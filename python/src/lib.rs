@@ -2,6 +2,7 @@
 //! Scenarios load as in `merge_sim` (built-in name, path, or TOML text); bad input raises
 //! `ScenarioError` with the CLI's message; the simulations run without the GIL.
 
+mod background;
 mod env_core;
 mod errors;
 mod external;

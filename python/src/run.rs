@@ -4,11 +4,13 @@ use mergesim::experiment::{InstanceOptions, RunError, run_quietly};
 use mergesim::report::time_series_csv;
 use pyo3::prelude::*;
 
+use crate::background::run_interruptible;
 use crate::errors::BindingError;
 use crate::source;
 
 /// Runs one instance; returns the JSON summary (`merge_sim run --json`) and the time series as
-/// CSV text (`merge_sim run --csv`). The GIL is released while the simulation runs.
+/// CSV text (`merge_sim run --csv`). The simulation runs without the GIL, on a pool of its own,
+/// and stops on Ctrl-C (`background`).
 #[pyfunction]
 #[pyo3(signature = (scenario, params_json = None, planner = None, seed = None))]
 pub fn run(
@@ -19,19 +21,26 @@ pub fn run(
     seed: Option<u64>,
 ) -> PyResult<(String, String)> {
     let scenario = source::load(scenario, params_json)?;
-    let options = InstanceOptions {
-        planner: planner.map(str::to_string),
-        seed,
-        keep_time_series: true,
-        interrupt: None,
-        profile: false,
-    };
-    let finished = py
-        .detach(|| run_quietly(&scenario, &options))
-        .map_err(|e| match e {
-            RunError::Setup(e) => BindingError::input(&e),
-            RunError::Run(e) => BindingError::run(&e),
-        })?;
+    // Checked as `merge_sim run --planner` checks it (the same message).
+    if let Some(name) = planner {
+        name.parse::<planner::PlannerKind>()
+            .map_err(|e| BindingError::input(&e))?;
+    }
+    let planner = planner.map(str::to_string);
+    let finished = run_interruptible(py, None, |interrupt| {
+        let options = InstanceOptions {
+            planner,
+            seed,
+            keep_time_series: true,
+            interrupt: Some(interrupt),
+            profile: false,
+        };
+        run_quietly(&scenario, &options)
+    })?
+    .map_err(|e| match e {
+        RunError::Setup(e) => BindingError::input(&e),
+        RunError::Run(e) => BindingError::run(&e),
+    })?;
     let summary = serde_json::to_string(&finished.summary)
         .map_err(|e| BindingError::Run(format!("cannot encode the summary: {e}")))?;
     Ok((summary, time_series_csv(&finished.outcome.time_series)))

@@ -8,13 +8,15 @@ use mergesim::sweep::{
 use planner::PlannerKind;
 use pyo3::prelude::*;
 
+use crate::background::run_interruptible;
 use crate::errors::BindingError;
 use crate::source;
 
 /// Sweeps `runs` instances drawn with sweep seed `seed` for every planner of `planners` (empty:
 /// the scenario's own); returns the JSONL rows (`merge_sim sweep --jsonl`) in instance order,
 /// the planners of an instance in the given order. Instance `i` has the same seed, so the same
-/// drawn scenario, for every planner. The GIL is released while the sweep runs.
+/// drawn scenario, for every planner. The sweep runs without the GIL and stops on Ctrl-C
+/// (`background`).
 #[pyfunction]
 #[pyo3(signature = (scenario, planners, runs, seed, params_json = None, threads = None))]
 pub fn sweep(
@@ -39,16 +41,19 @@ pub fn sweep(
         seed,
         shard: Shard::WHOLE,
     };
-    let options = SweepOptions {
-        threads,
-        ..SweepOptions::default()
-    };
-    let outcome = py
-        .detach(|| run_paired_sweep(&plan, &options, &|_| {}))
-        .map_err(|e| match e {
-            SweepError::Threads(_) => BindingError::run(&e),
-            SweepError::Invalid(_) => BindingError::input(&e),
-        })?;
+    let outcome = run_interruptible(py, Some(1), |interrupt| {
+        // The sweep builds its own pool of `threads` workers (one per core by default).
+        let options = SweepOptions {
+            threads,
+            interrupt: Some(interrupt),
+            ..SweepOptions::default()
+        };
+        run_paired_sweep(&plan, &options, &|_| {})
+    })?
+    .map_err(|e| match e {
+        SweepError::Threads(_) => BindingError::run(&e),
+        SweepError::Invalid(_) => BindingError::input(&e),
+    })?;
     // The sweep's identity (all its planners), as the CLI writes it on every line.
     let identity = SweepIdentity::of_paired(&plan);
     // (instance, planner index, line), sorted by instance then the plan's planner order.

@@ -102,3 +102,27 @@ def test_other_vehicle_and_planner() -> None:
     assert env.vehicle_names[env.agent] == "obstacle"
     obs, _ = env.reset(seed=0)
     assert obs[env.observation_names().index("lateral_offset_m")] == pytest.approx(0.0, abs=0.3)
+
+
+def test_a_collision_costs_the_collision_penalty_not_its_jerk() -> None:
+    """An impact's jerk is hundreds of m/s³: the comfort term is capped per step, so the
+    collision penalty is what the step costs."""
+    env = mergesim.MergeEnv()
+    env.reset(seed=7)
+    weights = env.reward_weights
+    for _ in range(250):
+        _, reward, terminated, truncated, info = env.step(np.array([30.0, 0.0], dtype=np.float32))
+        if terminated or truncated:
+            break
+    assert terminated and info["collision"], info
+    assert abs(info["jerk_mps3"]) > 100.0
+    lowest = -weights.collision - weights.comfort_cap
+    assert lowest <= reward < -weights.collision + 2.0 * weights.progress
+
+
+def test_bad_reward_weights_and_step_before_reset() -> None:
+    with pytest.raises(mergesim.ScenarioError, match="RewardWeights"):
+        mergesim.MergeEnv(params=SHORT, reward_weights={"jerk": 0.0})  # type: ignore[arg-type]
+    env = mergesim.MergeEnv(params=SHORT)
+    with pytest.raises(mergesim.ScenarioError, match="before reset"):
+        env.step(HOLD_LANE)

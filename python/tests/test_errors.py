@@ -98,3 +98,26 @@ def test_step_before_reset() -> None:
     env = mergesim.MergeEnv("urgent_merge")
     with pytest.raises(mergesim.ScenarioError, match="reset"):
         env.step([20.0, 0.0])
+
+
+def test_unknown_planner_same_message_as_the_cli(merge_sim: str) -> None:
+    """The CLI wraps the planner parser's message in clap's `invalid value ... for
+    '--planner <PLANNER>': `; Python raises that message itself, from every entry point."""
+    done = subprocess.run(
+        [merge_sim, "run", "--planner", "pf-nope", "--no-rrd", "--quiet"],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 2
+    prefix = "error: invalid value 'pf-nope' for '--planner <PLANNER>': "
+    assert done.stderr.startswith(prefix), done.stderr
+    expected = done.stderr[len(prefix):].splitlines()[0]
+    assert expected.startswith("unknown planner 'pf-nope'")
+    for call in (
+        lambda: mergesim.run("urgent_merge", planner="pf-nope"),
+        lambda: mergesim.sweep("urgent_merge", planners=["pf-cs", "pf-nope"], runs=1),
+        lambda: mergesim.MergeEnv("urgent_merge", planner="pf-nope"),
+    ):
+        with pytest.raises(mergesim.ScenarioError) as raised:
+            call()
+        assert str(raised.value) == expected

@@ -64,7 +64,8 @@ def test_threads_change_nothing(rows: pd.DataFrame) -> None:
 
 def test_a_row_replays_with_run(rows: pd.DataFrame) -> None:
     row = rows[(rows["planner"] == "pf-iso") & (rows["instance"] == 1)].iloc[0]
-    summary = mergesim.run("urgent_merge", planner="pf-iso", seed=int(row["seed"]), params=SHORT).summary
+    # The row's seed as it is (numpy.uint64), as python/README.md says.
+    summary = mergesim.run("urgent_merge", planner=row["planner"], seed=row["seed"], params=SHORT).summary
     assert summary["collisions"] == row["collisions"]
     assert summary["tet_s"] == row["tet_s"]
     assert summary["min_gap_m"] == row["min_gap_m"]
@@ -75,3 +76,48 @@ def test_paired_differences(rows: pd.DataFrame) -> None:
     assert list(diff.index) == [0, 1, 2]
     with pytest.raises(mergesim.ScenarioError):
         mergesim.paired_differences(rows, "min_speed_mps", "pf-cs", "pf-sp")
+
+
+def test_never_is_infinite_and_tied(rows: pd.DataFrame) -> None:
+    """null = +inf (no pair ever closing): kept in the rows as inf, both inf = a tie, as the CLI
+    counts it; NaN would drop the safest runs from means and from the paired differences."""
+    assert rows["min_ttc_s"].notna().all()
+    never = rows["min_ttc_s"] == float("inf")
+    assert never.any(), "expected some run without a closing pair in 2 s of urgent_merge"
+    diff = mergesim.paired_differences(rows, "min_ttc_s", "pf-cs", "pf-iso")
+    assert list(diff.index) == [0, 1, 2]
+    both_never = rows[never].groupby("instance").size() == 2
+    for instance in both_never[both_never].index:
+        assert diff[instance] == 0.0
+
+
+def test_paired_differences_agree_with_the_cli_counts(
+    merge_sim: str, short_urgent_merge: pathlib.Path, tmp_path: pathlib.Path
+) -> None:
+    summary = tmp_path / "paired.json"
+    subprocess.run(
+        [merge_sim, "sweep", "--scenario", str(short_urgent_merge), "--planners", ",".join(PLANNERS),
+         "--runs", "3", "--seed", "11", "--quiet", "--json", str(summary)],
+        check=True,
+    )
+    import json
+
+    cli = {
+        (d["vehicle"], d["metric"]): d
+        for d in json.loads(summary.read_text())["paired_differences"]
+    }
+    ours = mergesim.sweep(short_urgent_merge, planners=",".join(PLANNERS), runs=3, seed=11)
+    for column, key in [("min_ttc_s", (None, "min_ttc_s")), ("min_gap_m", (None, "min_gap_m")),
+                        ("ego.slowing_onset_s", ("ego", "slowing_onset_s"))]:
+        diff = mergesim.paired_differences(ours, column, *PLANNERS)
+        figure = cli[key]
+        assert int((diff < 0).sum()) == figure["lower"], column
+        assert int((diff > 0).sum()) == figure["higher"], column
+        assert int((diff == 0).sum()) == figure["tied"], column
+
+
+def test_paired_differences_bad_input(rows: pd.DataFrame) -> None:
+    with pytest.raises(mergesim.ScenarioError, match="same planner"):
+        mergesim.paired_differences(rows, "min_gap_m", "pf-cs", "pf-cs")
+    with pytest.raises(mergesim.ScenarioError, match="not a numeric column"):
+        mergesim.paired_differences(rows, "status", "pf-cs", "pf-iso")

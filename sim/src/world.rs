@@ -65,6 +65,7 @@ pub struct World {
     reported_collisions: usize,
     reported_edge_contacts: usize,
     profiler: Profiler,
+    planning_pool: Option<std::sync::Arc<rayon::ThreadPool>>,
 }
 
 fn steps_for(period_s: f64, dt_s: f64) -> u64 {
@@ -144,6 +145,7 @@ impl World {
             degraded_plans: 0,
             step_index: 0,
             profiler: Profiler::new(options.profile),
+            planning_pool: None,
             reported_collisions: 0,
             reported_edge_contacts: 0,
         })
@@ -166,6 +168,15 @@ impl World {
             .iter()
             .map(|a| a.vehicle.kinematics(&self.physics))
             .collect()
+    }
+
+    /// Decide the vehicles' plans on `pool` instead of rayon's current pool (the global one
+    /// outside a sweep). For embedders: a pool created in the current process keeps a forked
+    /// child (Python's multiprocessing) from waiting on the global pool's threads, which a fork
+    /// does not copy; a one-thread pool plans in sequence. Results are the same bit for bit
+    /// whatever the pool.
+    pub fn plan_on(&mut self, pool: std::sync::Arc<rayon::ThreadPool>) {
+        self.planning_pool = Some(pool);
     }
 
     /// Physics steps per planning cycle (`planner_period_s / dt_s`, at least one).

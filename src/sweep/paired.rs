@@ -429,8 +429,9 @@ impl SweepReport {
             SweepReport::Single(s) => s.table(),
             SweepReport::Paired(p) => {
                 let mut out = String::new();
+                let all_runs: u64 = p.per_planner.iter().map(|s| s.runs).sum();
                 for s in &p.per_planner {
-                    out.push_str(&s.table());
+                    out.push_str(&s.table_in_paired_sweep(all_runs));
                     out.push('\n');
                 }
                 out + &p.table()

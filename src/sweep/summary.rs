@@ -220,6 +220,32 @@ impl SweepSummary {
 
     /// A few lines for the terminal.
     pub fn table(&self) -> String {
+        let per_s = if self.wall_time_s > 0.0 {
+            self.runs as f64 / self.wall_time_s
+        } else {
+            0.0
+        };
+        self.table_with_timing(&format!(
+            "{} runs in {:.1} s wall ({per_s:.2} runs/s)",
+            self.runs, self.wall_time_s
+        ))
+    }
+
+    /// [`table`](Self::table) of one planner of a paired sweep of `all_runs` runs, whose wall
+    /// time (in `wall_time_s`) is the whole paired sweep's.
+    pub(crate) fn table_in_paired_sweep(&self, all_runs: u64) -> String {
+        let per_s = if self.wall_time_s > 0.0 {
+            all_runs as f64 / self.wall_time_s
+        } else {
+            0.0
+        };
+        self.table_with_timing(&format!(
+            "{} runs (the paired sweep: {all_runs} runs in {:.1} s wall, {per_s:.2} runs/s)",
+            self.runs, self.wall_time_s
+        ))
+    }
+
+    fn table_with_timing(&self, timing: &str) -> String {
         let opt = |v: Option<f64>, digits: usize| {
             v.map(|x| format!("{x:.digits$}"))
                 .unwrap_or_else(|| "-".into())
@@ -228,13 +254,8 @@ impl SweepSummary {
             v.map(|[l, h]| format!("[{l:.4}, {h:.4}]"))
                 .unwrap_or_else(|| "-".into())
         };
-        let per_s = if self.wall_time_s > 0.0 {
-            self.runs as f64 / self.wall_time_s
-        } else {
-            0.0
-        };
         format!(
-            "sweep {} {}: seed {}, shard {} (instances {}..{} of {}), {} runs in {:.1} s wall ({:.2} runs/s)\n\
+            "sweep {} {}: seed {}, shard {} (instances {}..{} of {}), {}\n\
              completed {}  diverged {} (panicked {})\n\
              collisions {}  rate {}  95% CI {}\n\
              near misses {}  rate {}  95% CI {}\n\
@@ -248,9 +269,7 @@ impl SweepSummary {
             self.instances[0],
             self.instances[1],
             self.total_runs,
-            self.runs,
-            self.wall_time_s,
-            per_s,
+            timing,
             self.completed,
             self.diverged,
             self.panicked,
