@@ -185,3 +185,33 @@ fn planning_on_a_given_pool_gives_the_same_bits() {
     let on_pool = world.run(|_| {}).unwrap();
     assert_bitwise_equal(&reference, &on_pool);
 }
+
+/// `planner_stats.optimiser_*`: PF-CS solves no speed program; PF-ISO solves at least once per
+/// cycle; one SCP iteration of the Newton QP leaves some cycles at the cap, which more
+/// iterations reduce.
+#[test]
+fn planner_stats_count_the_optimisers_solves_and_capped_cycles() {
+    let scenario = Scenario::load("urgent_merge").unwrap();
+    let cs = run(&scenario, Some(PlannerKind::PfCs), false).planner_stats;
+    assert_eq!(
+        (cs.optimiser_solves, cs.optimiser_iteration_cap_cycles),
+        (0, 0)
+    );
+    let iso = run(&scenario, Some(PlannerKind::PfIso), false).planner_stats;
+    assert!(iso.optimiser_solves >= iso.plans, "{iso:?}");
+    assert!(iso.optimiser_iteration_cap_cycles <= iso.plans);
+    let with_iterations = |iterations: usize| {
+        let mut s = scenario.clone();
+        s.sim.planner.speed_program = mergesim::planner::SpeedProgram::NewtonQp;
+        s.sim.planner.max_scp_iterations = iterations;
+        run(&s, Some(PlannerKind::PfIso), false).planner_stats
+    };
+    let one = with_iterations(1);
+    assert_eq!(one.optimiser_solves, one.plans);
+    assert!(one.optimiser_iteration_cap_cycles > 0, "{one:?}");
+    let four = with_iterations(4);
+    assert!(
+        four.optimiser_iteration_cap_cycles < one.optimiser_iteration_cap_cycles,
+        "{four:?} vs {one:?}"
+    );
+}

@@ -1,6 +1,6 @@
 //! The potential-field planners as a vehicle [`Behaviour`] (the simulator's extension point).
 
-use mergesim_types::{Behaviour, BehaviourError, Decision, GridSpec, Observation};
+use mergesim_types::{Behaviour, BehaviourError, Decision, GridSpec, Observation, OptimiserReport};
 
 use crate::planners::{PfPlanner, PlanRequest};
 
@@ -31,6 +31,15 @@ impl Behaviour for PfPlanner {
                 .last_stats()
                 .v2v_degraded
                 .then(|| "v2v-lost".to_string()),
+        })
+    }
+
+    /// The speed optimisation of the last cycle (PF-CS has none: no solves).
+    fn optimiser_report(&self) -> Option<OptimiserReport> {
+        let stats = self.last_stats();
+        Some(OptimiserReport {
+            solves: u32::try_from(stats.speed_solves).unwrap_or(u32::MAX),
+            stopped_at_iteration_cap: stats.speed_stopped_at_iteration_cap,
         })
     }
 

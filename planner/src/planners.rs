@@ -107,6 +107,9 @@ impl FromStr for PlannerKind {
 pub struct PlanStats {
     /// Convex speed solves of the cycle.
     pub speed_solves: usize,
+    /// Whether the speed optimisation's SCP stopped at `max_scp_iterations` before meeting its
+    /// tolerance ([`SpeedSolution::stopped_at_iteration_cap`](crate::speed_optimisation::SpeedSolution)).
+    pub speed_stopped_at_iteration_cap: bool,
     /// Whether the cubic fit needed the QP (a bound was active).
     pub cubic_qp: bool,
     /// Number of other vehicles in the interaction term.
@@ -460,6 +463,7 @@ impl PfPlanner {
                     .solve(params, &problem)
                     .map_err(|e| fail(e, Some(waypoints.clone())))?;
                 self.stats.speed_solves = solution.solves;
+                self.stats.speed_stopped_at_iteration_cap = solution.stopped_at_iteration_cap;
                 solution.speeds_mps
             }
         };

@@ -28,7 +28,8 @@ pub use config::{Driver, SimConfig, VehicleSpec, validate_vehicles};
 pub use error::SimError;
 pub use mergesim_types::{
     Behaviour, BehaviourError, Decision, GridSpec, Lane, MergeRoad, Neighbour, Observation,
-    PathPoint, SharedLocalPath, TimedWaypoint, VehicleId, VehicleShape, VehicleState,
+    OptimiserReport, PathPoint, SharedLocalPath, TimedWaypoint, VehicleId, VehicleShape,
+    VehicleState,
 };
 pub use observer::{PlanView, TickObserver, VehicleView};
 pub use outcome::{PlannerStats, RunOutcome, TimeSeriesRow};

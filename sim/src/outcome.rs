@@ -83,6 +83,15 @@ pub struct PlannerStats {
     /// Cycles decided in a degraded mode (PF-ISO without any shared path around: V2V lost).
     #[serde(default)]
     pub degraded_plans: u64,
+    /// Convex solves of the planners' optimisers, summed over the cycles (from
+    /// `Behaviour::optimiser_report`; the speed optimisation's for the potential-field
+    /// planners).
+    #[serde(default)]
+    pub optimiser_solves: u64,
+    /// Cycles whose optimiser ran out of iterations before meeting its tolerance (the SCP of
+    /// Eq. 10 at `max_scp_iterations`): how often the plan may be short of the optimum.
+    #[serde(default)]
+    pub optimiser_iteration_cap_cycles: u64,
     /// Median wall time of one cycle (µs). Wall-clock: not part of the determinism contract.
     pub p50_plan_us: f64,
     /// 99th percentile wall time of one cycle (µs).

@@ -86,6 +86,16 @@ impl Decision {
     }
 }
 
+/// How the last cycle's optimiser ended (optional: [`Behaviour::optimiser_report`]); the
+/// simulator sums it over a run (`planner_stats`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OptimiserReport {
+    /// Convex (or QP) solves of the cycle.
+    pub solves: u32,
+    /// Whether an iterative optimiser ran out of iterations before meeting its tolerance.
+    pub stopped_at_iteration_cap: bool,
+}
+
 /// A vehicle's decision making (module doc). `Send` so the simulator may plan vehicles in
 /// parallel.
 pub trait Behaviour: Send {
@@ -96,6 +106,12 @@ pub trait Behaviour: Send {
     /// Human-driver models answer `false`.
     fn is_planner(&self) -> bool {
         true
+    }
+
+    /// How the last [`plan`](Self::plan)'s optimiser ended, for the run's statistics (`None`:
+    /// nothing to report, the default).
+    fn optimiser_report(&self) -> Option<OptimiserReport> {
+        None
     }
 
     /// Its potential field on `spec`'s grid, row after row, for drawing; `None` if it has none.

@@ -15,7 +15,7 @@ pub mod path;
 pub mod road;
 pub mod vehicle;
 
-pub use behaviour::{Behaviour, BehaviourError, Decision, Observation};
+pub use behaviour::{Behaviour, BehaviourError, Decision, Observation, OptimiserReport};
 pub use bounds::Bound;
 pub use error::InvalidParameter;
 pub use grid::{GridSpec, MAX_GRID_CELLS};

@@ -145,6 +145,10 @@ pub struct SpeedSolution {
     pub solves: usize,
     /// Whether v_1 was anchored to the current speed.
     pub anchored: bool,
+    /// Whether the SCP ran all `max_scp_iterations` iterations without meeting its relative
+    /// tolerance (the answer may be short of the local optimum); false for the one exact solve
+    /// of a convex problem.
+    pub stopped_at_iteration_cap: bool,
 }
 
 /// J(v) of Eq. 10 (module doc), with the non-convex term if given.

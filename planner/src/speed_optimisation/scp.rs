@@ -194,6 +194,7 @@ impl SpeedOptimiser {
                 objective: j,
                 solves,
                 anchored,
+                stopped_at_iteration_cap: false,
             });
         }
 
@@ -215,6 +216,8 @@ impl SpeedOptimiser {
         let mut rho = params.trust_region_mps;
         let mut solves = 0;
         let mut solved_once = false;
+        // Cleared by every way out of the loop but running out of iterations.
+        let mut stopped_at_iteration_cap = true;
         for iteration in 0..params.max_scp_iterations {
             let g = gradient_at(&v);
             let (lo_k, hi_k): (Vec<f64>, Vec<f64>) = if iteration > 0 || trust_first {
@@ -245,7 +248,10 @@ impl SpeedOptimiser {
             let candidate = match solved {
                 Ok(candidate) => candidate,
                 Err(e) if !solved_once => return Err(e),
-                Err(_) => break,
+                Err(_) => {
+                    stopped_at_iteration_cap = false;
+                    break;
+                }
             };
             solved_once = true;
             let jc = objective(params, problem, &candidate);
@@ -282,6 +288,7 @@ impl SpeedOptimiser {
                 v = trial;
                 j = jt;
                 if decrease <= params.scp_relative_tolerance * j.abs().max(1.0) {
+                    stopped_at_iteration_cap = false;
                     break;
                 }
             }
@@ -296,6 +303,7 @@ impl SpeedOptimiser {
             objective: j,
             solves,
             anchored,
+            stopped_at_iteration_cap,
         })
     }
 }
@@ -387,6 +395,42 @@ mod tests {
         for (a, b) in again.speeds_mps.iter().zip(&solution.speeds_mps) {
             assert!((a - b).abs() < 1e-9, "{a} vs {b}");
         }
+    }
+
+    /// `stopped_at_iteration_cap`: true when the SCP runs out of iterations still improving,
+    /// false once it meets its tolerance, and false for the cone program's one exact solve.
+    #[test]
+    fn reports_whether_the_iteration_cap_stopped_it() {
+        let segment_lengths_m: Vec<f64> = vec![4.0; 12];
+        let max_speeds_mps = vec![30.0; 12];
+        let problem = SpeedProblem {
+            current_speed_mps: 15.0,
+            target_speed_mps: 15.0,
+            segment_lengths_m: &segment_lengths_m,
+            max_speeds_mps: &max_speeds_mps,
+            initial_guess_mps: Some(&[12.0; 12]),
+            interaction: None,
+            interaction_weight: 0.0,
+        };
+        let solve = |program: SpeedProgram, iterations: usize| {
+            let params = PlannerParams {
+                speed_program: program,
+                max_scp_iterations: iterations,
+                travel_time_weight: 40.0,
+                speed_deviation_weight: 0.8,
+                ..unbounded_params()
+            };
+            SpeedOptimiser::new().solve(&params, &problem).unwrap()
+        };
+        let one = solve(SpeedProgram::NewtonQp, 1);
+        assert_eq!(one.solves, 1);
+        assert!(one.stopped_at_iteration_cap);
+        let many = solve(SpeedProgram::NewtonQp, 30);
+        assert!(many.solves > 1 && many.solves < 30, "{}", many.solves);
+        assert!(!many.stopped_at_iteration_cap);
+        let exact = solve(SpeedProgram::Cone, 1);
+        assert_eq!(exact.solves, 1);
+        assert!(!exact.stopped_at_iteration_cap);
     }
 
     #[test]

@@ -120,6 +120,12 @@ impl World {
             let connected = agent.spec.connected;
             if is_planner {
                 self.plan_times_us.push(elapsed_us);
+                if let Some(report) = agent.behaviour.optimiser_report() {
+                    self.optimiser_solves += u64::from(report.solves);
+                    if report.stopped_at_iteration_cap {
+                        self.optimiser_iteration_cap_cycles += 1;
+                    }
+                }
                 if decision.degraded_mode.is_some() {
                     self.degraded_plans += 1;
                 }
