@@ -193,6 +193,10 @@ pub struct PlannerParams {
     pub max_scp_iterations: usize,
     /// SCP stops when the objective falls by less than this fraction of its magnitude.
     pub scp_relative_tolerance: f64,
+    /// SCP stops (stalled, not capped) when an iteration finds no descent step and the trust
+    /// region has shrunk below this (m/s); 0 (the default): never, it runs to
+    /// `max_scp_iterations`.
+    pub scp_stall_trust_region_mps: f64,
     /// Bound consecutive speeds by |v_{i+1} − v_i| ≤ a_max · Δt_plan (and v_1 against the
     /// current speed when that is feasible).
     pub accel_bound_enabled: bool,
@@ -311,6 +315,7 @@ impl Default for PlannerParams {
             trust_region_mps: 2.0,
             max_scp_iterations: 2,
             scp_relative_tolerance: 1e-4,
+            scp_stall_trust_region_mps: 0.0,
             accel_bound_enabled: true,
             max_accel_mps2: 3.0,
             jerk_bound_enabled: false,
@@ -386,6 +391,7 @@ pub const PLANNER_BOUNDS: &[Bound] = &[
     Bound::above("trust_region_mps", 0.0, 50.0, "m/s"),
     Bound::closed("max_scp_iterations", 1.0, 50.0, ""),
     Bound::closed("scp_relative_tolerance", 0.0, 1.0, ""),
+    Bound::closed("scp_stall_trust_region_mps", 0.0, 50.0, "m/s"),
     Bound::above("max_accel_mps2", 0.0, 20.0, "m/s²"),
     Bound::above("max_jerk_mps3", 0.0, 100.0, "m/s³"),
     Bound::closed("solver_max_iterations", 0.0, 1000.0, ""),
@@ -450,6 +456,10 @@ impl PlannerParams {
             ("trust_region_mps", self.trust_region_mps),
             ("max_scp_iterations", self.max_scp_iterations as f64),
             ("scp_relative_tolerance", self.scp_relative_tolerance),
+            (
+                "scp_stall_trust_region_mps",
+                self.scp_stall_trust_region_mps,
+            ),
             ("max_accel_mps2", self.max_accel_mps2),
             ("max_jerk_mps3", self.max_jerk_mps3),
             (

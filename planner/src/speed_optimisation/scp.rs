@@ -283,6 +283,11 @@ impl SpeedOptimiser {
             if step < 1.0 || accepted.is_none() {
                 rho *= 0.5;
             }
+            if accepted.is_none() && rho < params.scp_stall_trust_region_mps {
+                // No descent step and a trust region this small: stalled, not capped.
+                stopped_at_iteration_cap = false;
+                break;
+            }
             if let Some((trial, jt)) = accepted {
                 let decrease = j - jt;
                 v = trial;
