@@ -12,6 +12,7 @@
 mod args;
 mod commands;
 mod signals;
+mod sweep_commands;
 
 use std::process::ExitCode;
 
@@ -58,8 +59,8 @@ fn main() -> ExitCode {
         Some(Command::Compare(args)) => commands::cmd_compare(&args, &interrupt),
         Some(Command::Maneuver(args)) => commands::cmd_maneuver(&args),
         Some(Command::Scenario(cmd)) => commands::cmd_scenario(&cmd),
-        Some(Command::Sweep(args)) => commands::cmd_sweep(&args, &interrupt),
-        Some(Command::MergeResults(args)) => commands::cmd_merge_results(&args),
+        Some(Command::Sweep(args)) => sweep_commands::cmd_sweep(&args, &interrupt),
+        Some(Command::MergeResults(args)) => sweep_commands::cmd_merge_results(&args),
         Some(Command::Grid(args)) => commands::cmd_grid(&args, &interrupt),
         Some(Command::Limits) => commands::cmd_limits(),
     };
