@@ -142,6 +142,14 @@ fn plan_cycle(c: &mut Criterion) {
         speed_program: SpeedProgram::NewtonQp,
         ..planner.params().clone()
     };
+    // Both programs iterated to convergence: the cap and the stall test of the convergence
+    // criterion measured in docs/parameters.md (cap 20, stall below a 1 cm/s trust region).
+    let converged = |program: SpeedProgram| PlannerParams {
+        speed_program: program,
+        max_scp_iterations: 20,
+        scp_stall_trust_region_mps: 0.01,
+        ..planner.params().clone()
+    };
     for (name, params) in [
         (
             "pf_iso_plan_cycle_n20_one_neighbour_moving",
@@ -150,6 +158,14 @@ fn plan_cycle(c: &mut Criterion) {
         (
             "pf_iso_plan_cycle_n20_one_neighbour_moving_newton_qp",
             newton_qp,
+        ),
+        (
+            "pf_iso_plan_cycle_n20_one_neighbour_moving_converged",
+            converged(SpeedProgram::Cone),
+        ),
+        (
+            "pf_iso_plan_cycle_n20_one_neighbour_moving_newton_qp_converged",
+            converged(SpeedProgram::NewtonQp),
         ),
     ] {
         let fresh = || {
