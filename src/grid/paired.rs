@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{GridCell, GridOutcome, GridRow, VehicleFigures};
+use crate::sweep::statistics::{mean, standard_error};
 
 /// The figure a paired comparison looks at, for one vehicle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -208,18 +209,4 @@ impl GridOutcome {
         }
         text
     }
-}
-
-fn mean(values: &[f64]) -> Option<f64> {
-    (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
-}
-
-fn standard_error(values: &[f64]) -> Option<f64> {
-    if values.len() < 2 {
-        return None;
-    }
-    let n = values.len() as f64;
-    let m = values.iter().sum::<f64>() / n;
-    let var = values.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0);
-    Some((var / n).sqrt())
 }

@@ -41,6 +41,21 @@ pub(crate) fn scenario_file(name_or_path: &str) -> Vec<&Path> {
     }
 }
 
+/// A progress bar of `len` runs on a terminal (hidden when `quiet` or stderr is not one).
+pub(crate) fn progress_bar(quiet: bool, len: u64, message: String) -> indicatif::ProgressBar {
+    if quiet || !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(len);
+    let style = indicatif::ProgressStyle::with_template(
+        "{msg} [{bar:30}] {pos}/{len} runs, {per_sec}, ETA {eta}",
+    )
+    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+    bar.set_style(style);
+    bar.set_message(message);
+    bar
+}
+
 /// Recordings estimated above this size are announced before they are written.
 const RECORDING_WARNING_BYTES: f64 = 500e6;
 
@@ -311,18 +326,11 @@ pub(crate) fn cmd_grid(args: &GridArgs, interrupt: &Interrupt) -> Result<(), Fai
         threads: args.threads,
         interrupt: Some(interrupt.flag.clone()),
     };
-    let bar = if !args.quiet && std::io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new(job_count(&plan));
-        let style = indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:30}] {pos}/{len} runs, {per_sec}, ETA {eta}",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
-        bar.set_style(style);
-        bar.set_message(format!("grid {}", plan.scenario.name));
-        bar
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    let bar = progress_bar(
+        args.quiet,
+        job_count(&plan),
+        format!("grid {}", plan.scenario.name),
+    );
     let outcome = run_grid(&plan, &|| bar.inc(1));
     if interrupt.raised() {
         bar.finish_and_clear();

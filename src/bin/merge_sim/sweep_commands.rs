@@ -1,7 +1,7 @@
 //! `sweep` and `merge-results`: seeded Monte-Carlo sweeps (one planner or several, paired),
 //! their JSONL rows, resumption, Parquet, and merging the shards of a sweep.
 
-use std::io::{IsTerminal, Seek, Write};
+use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow};
@@ -9,7 +9,7 @@ use mergesim::output::check_output_path;
 use mergesim_types::files::read_regular_text;
 
 use crate::args::{MergeResultsArgs, SweepArgs};
-use crate::commands::{check_outputs, scenario_file};
+use crate::commands::{check_outputs, progress_bar, scenario_file};
 use crate::signals::Interrupt;
 use crate::{
     Failure, input, interrupted, load_scenario, out, outln, run_failure, sweep_failure,
@@ -134,18 +134,11 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
     {
         eprintln!("warning: {warning}");
     }
-    let bar = if !args.quiet && std::io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new(to_run);
-        let style = indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:30}] {pos}/{len} runs, {per_sec}, ETA {eta}",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
-        bar.set_style(style);
-        bar.set_message(format!("sweep {} shard {shard}", plan.scenario.name));
-        bar
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    let bar = progress_bar(
+        args.quiet,
+        to_run,
+        format!("sweep {} shard {shard}", plan.scenario.name),
+    );
     let write_error: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
     let on_run = |run: &mergesim::sweep::FinishedRun| {
         bar.inc(1);
