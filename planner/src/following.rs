@@ -23,9 +23,15 @@
 //!    feasible).
 //!
 //! A vehicle is *in the corridor* when its centre is ahead of the planning vehicle's and its
-//! lateral distance from the planned path at its longitudinal position is below the half-widths
-//! plus `following_lateral_margin_m`: the car it would hit by driving on, including one it is
-//! squeezing past in a single lane.
+//! lateral distance from the planned path is below the half-widths plus
+//! `following_lateral_margin_m`, at its longitudinal position now **or where the planning vehicle
+//! would reach it** (its position after the time the current closing speed needs to close the
+//! bumper gap): the car it would hit by driving on, including one it is squeezing past in a
+//! single lane, and one in the lane its path is about to enter. The second test matters in a
+//! merge: the path reaches the target lane some tens of metres ahead, where the slower car in
+//! that lane will be when the merging car catches up with it; tested only at the car's current
+//! position, the cap arrived once the two were already side by side (measured in
+//! `docs/robustness.md`).
 
 use serde::{Deserialize, Serialize};
 
@@ -76,6 +82,24 @@ fn path_y_at(path: &[[f64; 2]], x_m: f64) -> Option<f64> {
     path.last().map(|p| p[1])
 }
 
+/// Bumper-to-bumper gap (m) along X from the planning vehicle to a neighbour ahead of it.
+fn bumper_gap_m(ego: &VehicleState, ego_shape: &VehicleShape, n: &Neighbour) -> f64 {
+    n.state.x_m - ego.x_m - 0.5 * (ego_shape.length_m + n.shape.length_m)
+}
+
+/// Where along X (m) the planning vehicle would reach the neighbour `n` ahead of it if both kept
+/// their speeds: the neighbour's position after the time the closing speed needs to close the
+/// bumper gap; its current position when the planning vehicle is not closing in (or already
+/// overlaps it).
+fn meeting_x_m(ego: &VehicleState, ego_shape: &VehicleShape, n: &Neighbour) -> f64 {
+    let closing_mps = ego.speed_mps - n.state.speed_mps;
+    let gap_m = bumper_gap_m(ego, ego_shape, n);
+    if closing_mps <= 0.0 || gap_m <= 0.0 || !closing_mps.is_finite() || !gap_m.is_finite() {
+        return n.state.x_m;
+    }
+    n.state.x_m + n.state.speed_mps.max(0.0) * (gap_m / closing_mps)
+}
+
 /// The safe-following cap (m/s) of a vehicle at `ego` (shape `ego_shape`) planning along
 /// `path` (world points from its position on), behind the nearest neighbour in its corridor;
 /// `None` when no neighbour is in it.
@@ -92,13 +116,15 @@ pub fn following_cap_mps(
         .filter(|n| n.id != ego_id && n.state.x_m > ego.x_m)
         .filter(|n| {
             let half_widths_m = 0.5 * (ego_shape.width_m + n.shape.width_m);
-            path_y_at(path, n.state.x_m).is_some_and(|y| {
-                (y - n.state.y_m).abs() < half_widths_m + params.following_lateral_margin_m
-            })
+            let in_corridor_at = |x_m: f64| {
+                path_y_at(path, x_m).is_some_and(|y| {
+                    (y - n.state.y_m).abs() < half_widths_m + params.following_lateral_margin_m
+                })
+            };
+            in_corridor_at(n.state.x_m) || in_corridor_at(meeting_x_m(ego, ego_shape, n))
         })
         .map(|n| {
-            let gap_m = n.state.x_m - ego.x_m - 0.5 * (ego_shape.length_m + n.shape.length_m);
-            safe_following_speed_mps(params, gap_m, n.state.speed_mps)
+            safe_following_speed_mps(params, bumper_gap_m(ego, ego_shape, n), n.state.speed_mps)
         })
         .reduce(f64::min)
 }
@@ -172,5 +198,40 @@ mod tests {
             cap(&into_upper, &[beside]),
             Some(safe_following_speed_mps(&params, gap_m, 15.0))
         );
+    }
+
+    #[test]
+    fn a_car_in_the_lane_the_path_is_about_to_enter_caps_the_speed_where_it_would_be_reached() {
+        let params = PlannerParams::default();
+        let shape = VehicleShape::default();
+        // The path stays in the lower lane for 40 m, then reaches the upper lane by x = 80 m.
+        let merging: Vec<[f64; 2]> = (0..=20)
+            .map(|i| {
+                let x = 8.0 * i as f64;
+                [x, 1.75 + ((x - 40.0) / 40.0).clamp(0.0, 1.0) * 3.5]
+            })
+            .collect();
+        // 12 m ahead in the upper lane: where it is now the path is still in the lower lane.
+        let slower = neighbour(1, 12.0, 5.25, 13.0);
+        let cap = |ego_speed_mps: f64| {
+            let ego = VehicleState {
+                x_m: 0.0,
+                y_m: 1.75,
+                yaw_rad: 0.0,
+                speed_mps: ego_speed_mps,
+            };
+            following_cap_mps(&params, 0, &ego, &shape, &[slower], &merging)
+        };
+        // Closing at 6 m/s: the ego reaches it after (12 − L)/6 s, by when it is at
+        // x = 12 + 13 (12 − L)/6 ≈ 28 m, still on the lower-lane part of the path: no cap.
+        assert_eq!(cap(19.0), None);
+        // Closing at 1 m/s it is reached at x ≈ 12 + 13 (12 − L) > 80 m, in the upper lane.
+        let gap_m = 12.0 - shape.length_m;
+        assert_eq!(
+            cap(14.0),
+            Some(safe_following_speed_mps(&params, gap_m, 13.0))
+        );
+        // Not closing in: it stays ahead, where the path is still in the lower lane.
+        assert_eq!(cap(12.0), None);
     }
 }
