@@ -38,11 +38,10 @@
 //! # Solution
 //!
 //! Each SCP iteration solves a convex subproblem, posed one of two ways
-//! (`PlannerParams::speed_program`): [`SpeedProgram::Cone`] (default) keeps the travel time
-//! exact: t_i ≥ Δs_i / v_i ⇔ t_i v_i ≥ Δs_i, t_i, v_i ≥ 0
+//! (`PlannerParams::speed_program`): [`SpeedProgram::Cone`] keeps the travel time exact: t_i ≥ Δs_i / v_i ⇔ t_i v_i ≥ Δs_i, t_i, v_i ≥ 0
 //! ⇔ ‖(t_i − v_i, 2√Δs_i)‖ ≤ t_i + v_i, a second-order cone ([`cone_program`]);
 //! [`SpeedProgram::NewtonQp`] replaces it by its second-order Taylor model at the iterate, a QP
-//! ([`newton_qp`]), cheaper per solve. What follows is written for the cone program; the QP
+//! ([`newton_qp`]), cheaper per solve (the default). What follows is written for the cone program; the QP
 //! differs only where said. The interaction term is
 //! linearised at the current iterate v̄ (φ ≈ φ(v̄) + ∇φ(v̄)ᵀ(v − v̄)), the resulting convex
 //! cone program is solved inside the trust region |v_i − v̄_i| ≤ ρ, and the step d = v* − v̄
