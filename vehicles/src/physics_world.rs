@@ -28,6 +28,8 @@ pub struct PhysicsWorld {
     world: RapierWorld,
     dt_s: f64,
     steps: u64,
+    /// The colliders wheel rays can stand on (module doc of [`Self::cast_road_ray`]).
+    road_surfaces: Vec<ColliderHandle>,
 }
 
 impl PhysicsWorld {
@@ -53,6 +55,7 @@ impl PhysicsWorld {
             world,
             dt_s,
             steps: 0,
+            road_surfaces: Vec::new(),
         })
     }
 
@@ -112,6 +115,7 @@ impl PhysicsWorld {
                 .collision_groups(collision_groups::road_surface())
                 .build();
         let handle = self.world.insert_collider(collider, None);
+        self.road_surfaces.push(handle);
         self.refresh_queries();
         handle
     }
@@ -130,8 +134,25 @@ impl PhysicsWorld {
         params: &RoadColliderParams,
     ) -> RoadColliders {
         let colliders = build_merge_road(&mut self.world, road, params);
+        self.road_surfaces.push(colliders.surface);
         self.refresh_queries();
         colliders
+    }
+
+    /// Inserts a fixed collider the wheels can stand on (a ramp, a bump, a second pad), in the
+    /// road-surface collision groups. Wheel rays see only the colliders added through this
+    /// method, [`add_flat_ground`](Self::add_flat_ground) and
+    /// [`add_merge_road`](Self::add_merge_road): a collider inserted through
+    /// [`rapier_mut`](Self::rapier_mut) is solid for the chassis (if its groups say so) but
+    /// invisible to the wheels.
+    pub fn add_road_surface(&mut self, collider: ColliderBuilder) -> ColliderHandle {
+        let collider = collider
+            .collision_groups(collision_groups::road_surface())
+            .build();
+        let handle = self.world.insert_collider(collider, None);
+        self.road_surfaces.push(handle);
+        self.refresh_queries();
+        handle
     }
 
     /// Updates the broad phase so that scene queries (wheel rays, spawn checks) see colliders
@@ -183,7 +204,41 @@ impl PhysicsWorld {
     }
 
     /// First road-surface hit of a ray (wheel-ray groups), with its normal.
+    ///
+    /// The ray is cast against the few road-surface colliders directly (those added by
+    /// [`add_flat_ground`](Self::add_flat_ground), [`add_merge_road`](Self::add_merge_road) and
+    /// [`add_road_surface`](Self::add_road_surface)), not through rapier's query pipeline, whose
+    /// tree also holds every chassis: the same parry ray cast on the same shapes at the same
+    /// poses (so the same hit, bit for bit, as `tests` checks against the pipeline), without
+    /// walking a tree that grows with the number of vehicles. Four rays per vehicle per step
+    /// made that walk a measurable share of the tire forces' time.
     pub(crate) fn cast_road_ray(&self, ray: &Ray, max_toi_m: Real) -> Option<RayIntersection> {
+        let groups = collision_groups::wheel_ray();
+        let mut best: Option<RayIntersection> = None;
+        let mut max_toi = max_toi_m;
+        for &handle in &self.road_surfaces {
+            let Some(collider) = self.world.colliders.get(handle) else {
+                continue;
+            };
+            if !collider.is_enabled() || !collider.collision_groups().test(groups) {
+                continue;
+            }
+            if let Some(hit) =
+                collider
+                    .shape()
+                    .cast_ray_and_get_normal(collider.position(), ray, max_toi, true)
+            {
+                max_toi = hit.time_of_impact;
+                best = Some(hit);
+            }
+        }
+        best
+    }
+
+    /// [`cast_road_ray`](Self::cast_road_ray) through rapier's query pipeline (the reference
+    /// the direct cast is tested against).
+    #[cfg(test)]
+    fn cast_road_ray_via_pipeline(&self, ray: &Ray, max_toi_m: Real) -> Option<RayIntersection> {
         let filter = QueryFilter::new().groups(collision_groups::wheel_ray());
         self.world
             .query_pipeline_with_filter(filter)
@@ -214,5 +269,56 @@ mod tests {
         let ray = Ray::new(Vector::new(3.0, -7.0, 2.0), Vector::new(0.0, 0.0, -1.0));
         let hit = world.cast_road_ray(&ray, 10.0).map(|h| h.time_of_impact);
         assert_eq!(hit, Some(2.0));
+    }
+
+    #[test]
+    fn direct_road_rays_hit_what_the_query_pipeline_hits_bit_for_bit() {
+        let mut world = PhysicsWorld::new(0.002).unwrap_or_else(|e| panic!("{e}"));
+        world.add_merge_road(&mergesim_types::MergeRoad::default());
+        // A tilted ramp overlapping the road, and chassis boxes (invisible to wheel rays) in
+        // the pipeline's tree.
+        world.add_road_surface(
+            ColliderBuilder::cuboid(3.0, 2.0, 0.2)
+                .translation(Vector::new(40.0, 1.75, 0.0))
+                .rotation(Vector::new(0.0, 0.1, 0.05)),
+        );
+        for i in 0..20 {
+            let chassis = ColliderBuilder::cuboid(2.25, 0.8, 0.7)
+                .translation(Vector::new(10.0 * i as Real, 1.75, 0.9))
+                .collision_groups(collision_groups::vehicle())
+                .build();
+            world.rapier_mut().insert_collider(chassis, None);
+        }
+        world.refresh_queries();
+        let mut hits = 0;
+        for ix in 0..300 {
+            for iy in 0..13 {
+                let x = -80.0 + 0.37 * ix as Real * 9.0;
+                let y = -6.0 + 1.3 * iy as Real;
+                let origin = Vector::new(x, y, 1.2);
+                for dir in [
+                    Vector::new(0.0, 0.0, -1.0),
+                    Vector::new(0.05, -0.02, -1.0).normalize(),
+                ] {
+                    let ray = Ray::new(origin, dir);
+                    let direct = world.cast_road_ray(&ray, 2.0);
+                    let reference = world.cast_road_ray_via_pipeline(&ray, 2.0);
+                    assert_eq!(
+                        direct.map(|h| (
+                            h.time_of_impact.to_bits(),
+                            h.normal.to_array().map(f32::to_bits)
+                        )),
+                        reference.map(|h| (
+                            h.time_of_impact.to_bits(),
+                            h.normal.to_array().map(f32::to_bits)
+                        )),
+                        "ray from {origin:?} along {dir:?}"
+                    );
+                    hits += usize::from(direct.is_some());
+                }
+            }
+        }
+        // Both some hits and some misses (beyond the road's ends and edges).
+        assert!(hits > 1000 && hits < 300 * 13 * 2, "{hits}");
     }
 }
