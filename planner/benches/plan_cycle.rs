@@ -137,17 +137,13 @@ fn plan_cycle(c: &mut Criterion) {
             (t_s, ego_k, other_k, vec![shared])
         })
         .collect();
-    // The same with the Newton QP as the convex subproblem (`speed_program = "newton-qp"`).
-    let newton_qp = PlannerParams {
-        speed_program: SpeedProgram::NewtonQp,
-        ..planner.params().clone()
-    };
-    // Both programs iterated to convergence: the cap and the stall test of the convergence
-    // criterion measured in docs/parameters.md (cap 20, stall below a 1 cm/s trust region).
-    let converged = |program: SpeedProgram| PlannerParams {
+    // The defaults (the Newton QP, the SCP iterated to convergence: at most 20 iterations,
+    // stalled below a 1 cm/s trust region; docs/parameters.md), the cone program iterated the
+    // same way, and the defaults before 2026-12-02 (the cone program, two SCP iterations).
+    let with = |program: SpeedProgram, max_scp_iterations: usize, stall_mps: f64| PlannerParams {
         speed_program: program,
-        max_scp_iterations: 20,
-        scp_stall_trust_region_mps: 0.01,
+        max_scp_iterations,
+        scp_stall_trust_region_mps: stall_mps,
         ..planner.params().clone()
     };
     for (name, params) in [
@@ -156,16 +152,12 @@ fn plan_cycle(c: &mut Criterion) {
             planner.params().clone(),
         ),
         (
-            "pf_iso_plan_cycle_n20_one_neighbour_moving_newton_qp",
-            newton_qp,
+            "pf_iso_plan_cycle_n20_one_neighbour_moving_cone",
+            with(SpeedProgram::Cone, 20, 0.01),
         ),
         (
-            "pf_iso_plan_cycle_n20_one_neighbour_moving_converged",
-            converged(SpeedProgram::Cone),
-        ),
-        (
-            "pf_iso_plan_cycle_n20_one_neighbour_moving_newton_qp_converged",
-            converged(SpeedProgram::NewtonQp),
+            "pf_iso_plan_cycle_n20_one_neighbour_moving_cone_two_iterations",
+            with(SpeedProgram::Cone, 2, 0.0),
         ),
     ] {
         let fresh = || {
