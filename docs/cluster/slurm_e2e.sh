@@ -170,7 +170,7 @@ wait_for "${jid}_$FAIL_TASK" 'FAILED|COMPLETED'
 log="mergesim-sweep_${jid}_$FAIL_TASK.log"
 say "task $FAIL_TASK failed as provoked; its log $log:"
 sed 's/^/    /' "$log"
-grep -q "shard $FAIL_TASK/$SHARDS = instances" "$log" || fail "no shard banner in $log"
+grep -q "shard $FAIL_TASK/$SHARDS," "$log" || fail "no task banner in $log"
 grep -q "not a regular file\|directory" "$log" || fail "$log does not name the cause"
 [ "$(state "$mid")" = PENDING ] || fail "the merge job is $(state "$mid"), not waiting"
 say "the merge job $mid is still pending: $(scontrol show job -o "$mid" | grep -o 'Dependency=[^ ]*')"
@@ -219,7 +219,7 @@ cmp -s "$WORK/whole.sorted" "$WORK/merged.rows" ||
 [ "$(jq -s 'map(select(.wall_time_s != null)) | length' "$OUT/runs.jsonl")" = 0 ] ||
     fail "runs.jsonl has per-run wall times"
 say "runs.jsonl: $rows rows, equal to the unsharded rows in instance order (instances" \
-    "$(jq -s -c '[.[].instance] | unique | "\(first)..\(last)"' "$OUT/runs.jsonl"))"
+    "$(jq -r -s '[.[].instance] | "\(first)..\(last)"' "$OUT/runs.jsonl"))"
 glob_order=$(cd "$OUT" && echo shard_*.jsonl)
 say "(a glob lists the shards as: $glob_order)"
 shard_list=()

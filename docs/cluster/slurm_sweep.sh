@@ -58,8 +58,8 @@ echo "mergesim task ${SLURM_ARRAY_JOB_ID}_${TASK} on $(hostname): $SCENARIO $PLA
     "runs $RUNS, seed $SEED, shard $TASK/$SHARDS, $THREADS threads, OUT=$OUT," \
     "$("$MERGE_SIM" --version)"
 if [ "${SLURM_ARRAY_TASK_COUNT:-$SHARDS}" != "$SHARDS" ]; then
-    echo "note: this array has ${SLURM_ARRAY_TASK_COUNT} tasks, SHARDS=$SHARDS (expected when a" \
-        "task runs again alone)"
+    echo "note: this array has ${SLURM_ARRAY_TASK_COUNT} task(s), SHARDS=$SHARDS (expected when a" \
+        "task runs again alone: the shard is $TASK/$SHARDS all the same)"
 fi
 
 mkdir -p "$OUT"
@@ -71,9 +71,14 @@ SEED=$SEED
 SHARDS=$SHARDS"
 if [ -e "$OUT/sweep.env" ]; then
     if [ "$(cat "$OUT/sweep.env")" != "$identity" ]; then
-        echo "error: $OUT/sweep.env holds another sweep:" >&2
-        cat "$OUT/sweep.env" >&2
-        echo "choose another OUT for this one" >&2
+        {
+            echo "error: $OUT/sweep.env holds another sweep:"
+            sed 's/^/    /' "$OUT/sweep.env"
+            echo "but this task is:"
+            printf '%s\n' "$identity" | sed 's/^/    /'
+            echo "run this task with the settings of the sweep in OUT (e.g. SHARDS), or choose" \
+                "another OUT for a new sweep"
+        } >&2
         exit 2
     fi
 else
