@@ -22,6 +22,9 @@
 # it also works if OUT is given: OUT=results/mergesim_<jid> sbatch --array=3 slurm_sweep.sh.
 # --resume makes a requeued or preempted task continue from the rows its JSONL holds. Slurm's
 # time limit and scancel send SIGTERM first: the task keeps every finished row and exits 143.
+# The log is appended to (--open-mode=append), so a requeued task's log keeps the failure.
+# --cpus-per-task: a request larger than any node of the partition may pend for ever without an
+# error (compare with `sinfo -o '%n %c %m'`); override it with sbatch -c N.
 #
 # merge_sim must run on the compute nodes: install it where they see it (docs/cluster/README.md:
 # `cargo install --path . --bin merge_sim --root /shared/prefix`, a glibc on the nodes at least

@@ -342,6 +342,10 @@ pub(crate) fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> 
     }
     if !args.quiet {
         out!("{}", merged.table());
+        outln!(
+            "(wall time: the sum of the {} shards' wall times, not the elapsed time)",
+            args.inputs.len()
+        );
     }
     Ok(())
 }
