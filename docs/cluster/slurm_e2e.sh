@@ -70,6 +70,7 @@ else
     cp "${CARGO_TARGET_DIR:-$repo/target}/release/merge_sim" "$WORK/prefix/bin/merge_sim"
 fi
 export PATH="$WORK/prefix/bin:$PATH"
+unset MERGE_SIM # the tasks find merge_sim on PATH, as documented
 needs=$(grep -ao 'GLIBC_2\.[0-9]*' "$WORK/prefix/bin/merge_sim" | sort -uV | tail -1)
 say "merge_sim: $(merge_sim --version) in $WORK/prefix/bin (on PATH, passed on by sbatch's" \
     "default --export=ALL); it needs $needs, this node has $(ldd --version | head -1)"
@@ -81,8 +82,15 @@ cleanup() {
     for pid in "${started[@]}"; do
         kill "$pid" 2>/dev/null || true
     done
+    # The daemons write their state as they stop: wait for them before removing it.
+    for pid in "${started[@]}"; do
+        for _ in $(seq 50); do
+            kill -0 "$pid" 2>/dev/null || break
+            sleep 0.2
+        done
+    done
     if [ "${KEEP:-0}" != 1 ]; then
-        rm -rf "$WORK"
+        rm -rf "$WORK" || echo "warning: could not remove all of $WORK" >&2
     fi
 }
 trap cleanup EXIT
@@ -154,9 +162,14 @@ wait_for() {
 OUT="$WORK/results/sweep"
 mkdir -p "$OUT/shard_$FAIL_TASK.json" # the provoked failure: an output that is a directory
 cd "$WORK/submit"
-vars="SCENARIO=$SCENARIO,PLANNERS=$PLANNERS,RUNS=$RUNS,SEED=$SEED,SHARDS=$SHARDS,OUT=$OUT"
-jid=$(sbatch --parsable --hold --array="0-$((SHARDS - 1))" --cpus-per-task=1 --mem=200M \
-    --export="ALL,$vars" "$repo/docs/cluster/slurm_sweep.sh")
+# The settings go through the environment (sbatch's default --export=ALL), not an --export
+# list: Slurm splits that at commas, so PLANNERS=pf-cs,pf-iso would arrive as PLANNERS=pf-cs.
+with_settings() {
+    env SCENARIO="$SCENARIO" PLANNERS="$PLANNERS" RUNS="$RUNS" SEED="$SEED" SHARDS="$SHARDS" \
+        OUT="$OUT" "$@"
+}
+jid=$(with_settings sbatch --parsable --hold --array="0-$((SHARDS - 1))" --cpus-per-task=1 \
+    --mem=200M "$repo/docs/cluster/slurm_sweep.sh")
 mid=$(sbatch --parsable --dependency="afterany:$jid" --mem=200M --export="ALL,OUT=$OUT" \
     "$repo/docs/cluster/slurm_merge.sh")
 say "submitted the sweep as array job $jid (tasks 0-$((SHARDS - 1)): $RUNS runs of $SCENARIO" \
@@ -206,8 +219,9 @@ no_walls='walk(if type == "object" then del(.wall_time_s) else . end)'
 diff <(jq -S "$no_walls" "$WORK/whole.json") <(jq -S "$no_walls" "$OUT/sweep.json") >/dev/null ||
     fail "sweep.json differs from the unsharded aggregate"
 say "sweep.json equals the unsharded aggregate in every field but wall_time_s:" \
-    "$(jq -c '{runs, collisions, near_misses, min_gap_m_p5, mean_peak_yaw_rate_radps}' \
-        "$OUT/sweep.json" 2>/dev/null || jq -c '.planners' "$OUT/sweep.json")"
+    "$(jq -c 'def figures: {planner, runs, collisions, near_misses, min_gap_m_p5,
+        mean_peak_yaw_rate_radps}; if .per_planner then [.per_planner[] | figures] else figures
+        end' "$OUT/sweep.json")"
 # The unsharded rows (completion order) sorted by instance, then the sweep's planner order.
 sorted='sort_by(.instance, (.planner as $p | .planners | index($p))) | .[] | del(.wall_time_s)'
 jq -s -c "$sorted" "$WORK/whole.jsonl" >"$WORK/whole.sorted"
@@ -218,7 +232,7 @@ cmp -s "$WORK/whole.sorted" "$WORK/merged.rows" ||
         "$WORK/whole.sorted" "$WORK/merged.rows" | head -c 600)"
 [ "$(jq -s 'map(select(.wall_time_s != null)) | length' "$OUT/runs.jsonl")" = 0 ] ||
     fail "runs.jsonl has per-run wall times"
-say "runs.jsonl: $rows rows, equal to the unsharded rows in instance order (instances" \
+say "runs.jsonl: $rows rows, equal to the unsharded rows in (instance, planner) order (instances" \
     "$(jq -r -s '[.[].instance] | "\(first)..\(last)"' "$OUT/runs.jsonl"))"
 glob_order=$(cd "$OUT" && echo shard_*.jsonl)
 say "(a glob lists the shards as: $glob_order)"
@@ -232,8 +246,8 @@ say "the merged wall_time_s $merged s is the sum of the shards' (the array's ela
     "was shorter: the tasks ran 2 at a time)"
 
 # --- 4. resubmitting one task -------------------------------------------------------------------
-rid=$(sbatch --parsable --array="$RESUBMIT_TASK" --cpus-per-task=1 --mem=200M \
-    --export="ALL,$vars" "$repo/docs/cluster/slurm_sweep.sh")
+rid=$(with_settings sbatch --parsable --array="$RESUBMIT_TASK" --cpus-per-task=1 --mem=200M \
+    "$repo/docs/cluster/slurm_sweep.sh")
 wait_for "$rid" 'COMPLETED|FAILED|CANCELLED'
 rlog="mergesim-sweep_${rid}_$RESUBMIT_TASK.log"
 say "resubmitted task $RESUBMIT_TASK alone (sbatch --array=$RESUBMIT_TASK, OUT given): job $rid" \
@@ -242,9 +256,8 @@ sed 's/^/    /' "$rlog"
 [ "$(state "$rid")" = COMPLETED ] || fail "the resubmitted task failed"
 grep -q "shard $RESUBMIT_TASK/$SHARDS = instances" "$rlog" || fail "wrong shard in $rlog"
 grep -q "0 to run" "$rlog" || fail "the resubmitted task ran its shard again"
-bad=$(sbatch --parsable --array="$RESUBMIT_TASK" --cpus-per-task=1 --mem=200M \
-    --export="ALL,SCENARIO=$SCENARIO,PLANNERS=$PLANNERS,RUNS=$RUNS,SEED=$SEED,OUT=$OUT" \
-    "$repo/docs/cluster/slurm_sweep.sh")
+bad=$(with_settings env -u SHARDS sbatch --parsable --array="$RESUBMIT_TASK" --cpus-per-task=1 \
+    --mem=200M "$repo/docs/cluster/slurm_sweep.sh")
 wait_for "$bad" 'COMPLETED|FAILED|CANCELLED'
 say "resubmitted it without SHARDS (the default 16): job $bad $(state "$bad"); its log:"
 sed 's/^/    /' "mergesim-sweep_${bad}_$RESUBMIT_TASK.log"

@@ -11,7 +11,8 @@
 #   RUNS=2000 SEED=7 PLANNERS=pf-cs,pf-iso SHARDS=8 sbatch --array=0-7 docs/cluster/slurm_sweep.sh
 #
 # Variables: SCENARIO (a built-in name or a TOML path readable on the nodes), PLANNERS (one, or
-# several comma-separated: a paired sweep), RUNS, SEED, SHARDS (= the array's size), OUT (the
+# several separated by commas or colons: a paired sweep; in an sbatch --export list, which Slurm
+# splits at commas, write PLANNERS=pf-cs:pf-iso), RUNS, SEED, SHARDS (= the array's size), OUT (the
 # sweep's directory; default results/mergesim_<array job id>, so every sweep gets its own),
 # MERGE_SIM (the binary; default `merge_sim` on PATH), THREADS (default: the CPUs Slurm gave).
 #
@@ -42,6 +43,7 @@ set -euo pipefail
 
 SCENARIO=${SCENARIO:-urgent_merge}
 PLANNERS=${PLANNERS:-pf-iso}
+PLANNERS=${PLANNERS//:/,}
 RUNS=${RUNS:-10000}
 SEED=${SEED:-42}
 SHARDS=${SHARDS:-16}
@@ -61,8 +63,8 @@ echo "mergesim task ${SLURM_ARRAY_JOB_ID}_${TASK} on $(hostname): $SCENARIO $PLA
     "runs $RUNS, seed $SEED, shard $TASK/$SHARDS, $THREADS threads, OUT=$OUT," \
     "$("$MERGE_SIM" --version)"
 if [ "${SLURM_ARRAY_TASK_COUNT:-$SHARDS}" != "$SHARDS" ]; then
-    echo "note: this array has ${SLURM_ARRAY_TASK_COUNT} task(s), SHARDS=$SHARDS (expected when a" \
-        "task runs again alone: the shard is $TASK/$SHARDS all the same)"
+    echo "note: this array has ${SLURM_ARRAY_TASK_COUNT} task(s) but SHARDS=$SHARDS: this task" \
+        "runs shard $TASK/$SHARDS (right for a task of a $SHARDS-shard sweep run again alone)"
 fi
 
 mkdir -p "$OUT"
