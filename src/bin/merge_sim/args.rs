@@ -251,8 +251,8 @@ pub(crate) struct MergeResultsArgs {
     #[arg(required = true, value_name = "SHARD_JSON")]
     pub(crate) inputs: Vec<PathBuf>,
     /// Write the aggregate of the whole sweep here: what the unsharded sweep's --json holds,
-    /// except `wall_time_s`, here the sum of the shards' wall times (CPU-side effort, not the
-    /// elapsed time of the array).
+    /// except `wall_time_s`, here the sum of the shards' wall times (the time the shards
+    /// took together, not the elapsed time of the array).
     #[arg(long, value_name = "PATH")]
     pub(crate) json: Option<PathBuf>,
     /// Write the rows of the whole sweep as JSONL here, in instance order (then in the sweep's
