@@ -19,8 +19,10 @@
 # The shard is passed explicitly (--shard TASK/SHARDS), never taken from the array's size: a
 # task run again alone is an array of one task. A failed task is best run again with
 #   scontrol requeue <array job id>_<task>
-# (same job id, so the same OUT; the merge job chained with afterany waits for it). Resubmitting
-# it also works if OUT is given: OUT=results/mergesim_<jid> sbatch --array=3 slurm_sweep.sh.
+# (same job id, so the same OUT; the merge job chained with afterany waits for it if the other
+# tasks are still running, else submit the merge again). Resubmitting it also works if OUT and
+# the sweep's settings are given: OUT=results/mergesim_<jid> SHARDS=16 sbatch --array=3 ...;
+# settings that differ from the sweep recorded in OUT/sweep.env are refused.
 # --resume makes a requeued or preempted task continue from the rows its JSONL holds. Slurm's
 # time limit and scancel send SIGTERM first: the task keeps every finished row and exits 143.
 # The log is appended to (--open-mode=append), so a requeued task's log keeps the failure.
