@@ -46,7 +46,7 @@ use thiserror::Error;
 use crate::summary::RunSummary;
 pub use engine::{RunRequest, run_paired_sweep_with, validate_paired};
 pub use figures::{RunFigures, VehicleRow, drawn_values};
-pub use merge::{merge_reports, merge_shards};
+pub use merge::{merge_reports, merge_shards, merged_jsonl};
 pub use paired::{BetterWhen, PairedDifference, PairedSweepSummary, SweepReport};
 pub use rows::{JsonlRecord, RunMetrics, RunRow, RunStatus};
 pub use shard::{Shard, ShardError};

@@ -335,3 +335,248 @@ fn every_builtin_is_listed_and_shows_as_toml_that_reads_back_unchanged() {
         );
     }
 }
+
+/// The shard files as a shell glob lists them: `shard_0, shard_1, shard_10, shard_11, shard_2,
+/// ...` (lexical order, not shard order).
+fn glob_order(dir: &Path, count: usize) -> Vec<String> {
+    let mut names: Vec<String> = (0..count)
+        .map(|i| p(&dir.join(format!("shard_{i}.json"))).to_string())
+        .collect();
+    names.sort();
+    names
+}
+
+/// `v` without any `wall_time_s` (a paired aggregate has one per planner too).
+fn without_wall_times(mut v: Value) -> Value {
+    match &mut v {
+        Value::Object(obj) => {
+            obj.remove("wall_time_s");
+            for value in obj.values_mut() {
+                *value = without_wall_times(value.take());
+            }
+        }
+        Value::Array(items) => {
+            for value in items.iter_mut() {
+                *value = without_wall_times(value.take());
+            }
+        }
+        _ => {}
+    }
+    v
+}
+
+/// The lines of a JSONL file in file order.
+fn jsonl_lines(path: &Path) -> Vec<Value> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+/// A 12-shard sweep (one planner, then two paired): `merge-results --jsonl` writes the
+/// unsharded sweep's rows sorted by (instance, planner in the sweep's order), whatever the
+/// order of the shard files (here a shell glob's: 0, 1, 10, 11, 2, ...); the merged JSONL is a
+/// valid JSONL of the unsharded sweep (`--resume` on it has nothing to run and gives the same
+/// aggregate); `wall_time_s` of the merge is the sum of the shards'.
+#[test]
+fn twelve_shards_merge_into_the_unsharded_rows_in_order_single_and_paired() {
+    const SHARDS: usize = 12;
+    for (name, planners, runs) in [("single", "pf-iso", "24"), ("paired", "pf-cs,pf-iso", "12")] {
+        let dir = scratch(&format!("sweep_twelve_{name}"));
+        let common = [
+            "sweep",
+            "--quiet",
+            "--scenario",
+            "urgent_merge",
+            "--planners",
+            planners,
+            "--runs",
+            runs,
+            "--seed",
+            "5",
+        ];
+        let whole_json = dir.join("whole.json");
+        let whole_jsonl = dir.join("whole.jsonl");
+        let mut args = common.to_vec();
+        args.extend(["--json", p(&whole_json), "--jsonl", p(&whole_jsonl)]);
+        let out = merge_sim(&args, &[]);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        let mut shard_wall_time = 0.0;
+        for index in 0..SHARDS {
+            let json = dir.join(format!("shard_{index}.json"));
+            let shard = format!("{index}/{SHARDS}");
+            let mut args = common.to_vec();
+            args.extend(["--threads", "1", "--shard", &shard, "--json", p(&json)]);
+            let out = merge_sim(&args, &[]);
+            assert!(out.status.success(), "{name} {shard}: {}", stderr(&out));
+            // The one-line banner, even with --quiet: a job log says which shard ran.
+            assert!(
+                stderr(&out).contains(&format!("shard {shard} = instances")),
+                "{}",
+                stderr(&out)
+            );
+            shard_wall_time += read_json(&json)["wall_time_s"].as_f64().unwrap();
+        }
+        let merged_json = dir.join("merged.json");
+        let merged_jsonl = dir.join("merged.jsonl");
+        // An existing regular file is replaced (as --json and --parquet are).
+        std::fs::write(&merged_jsonl, "old\n").unwrap();
+        let mut args = vec!["merge-results", "--quiet"];
+        let files = glob_order(&dir, SHARDS);
+        assert_eq!(files[2], p(&dir.join("shard_10.json")), "not glob order");
+        args.extend(files.iter().map(String::as_str));
+        args.extend(["--json", p(&merged_json), "--jsonl", p(&merged_jsonl)]);
+        let out = merge_sim(&args, &[]);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        let merged = read_json(&merged_json);
+        assert_eq!(
+            without_wall_times(merged.clone()),
+            without_wall_times(read_json(&whole_json)),
+            "{name}"
+        );
+        let merged_wall = merged["wall_time_s"].as_f64().unwrap();
+        assert!(
+            (merged_wall - shard_wall_time).abs() <= 1e-9 * shard_wall_time.max(1.0),
+            "{name}: wall_time_s {merged_wall} is not the shards' sum {shard_wall_time}"
+        );
+
+        // The rows, in file order, are the unsharded sweep's sorted by (instance, planner).
+        let order: Vec<&str> = planners.split(',').collect();
+        let mut expected = jsonl_lines(&whole_jsonl);
+        expected.sort_by_key(|r| {
+            let planner = r["planner"].as_str().unwrap();
+            (
+                r["instance"].as_u64().unwrap(),
+                order.iter().position(|p| *p == planner).unwrap(),
+            )
+        });
+        let rows = jsonl_lines(&merged_jsonl);
+        let total: usize = runs.parse::<usize>().unwrap() * order.len();
+        assert_eq!(rows.len(), total, "{name}");
+        assert_eq!(expected.len(), total, "{name}");
+        for (row, want) in rows.iter().zip(&expected) {
+            assert!(row["wall_time_s"].is_null(), "{name}: {row}");
+            assert_eq!(
+                without_wall_time(row.clone()),
+                without_wall_time(want.clone()),
+                "{name}"
+            );
+        }
+        // The merged file is the JSONL of the unsharded sweep: nothing left to run.
+        let resumed_json = dir.join("resumed.json");
+        let mut args = common.to_vec();
+        args.extend([
+            "--json",
+            p(&resumed_json),
+            "--jsonl",
+            p(&merged_jsonl),
+            "--resume",
+        ]);
+        let out = merge_sim(&args, &[]);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        assert!(stderr(&out).contains("0 to run"), "{}", stderr(&out));
+        assert_eq!(
+            without_wall_times(read_json(&resumed_json)),
+            without_wall_times(read_json(&whole_json)),
+            "{name}"
+        );
+    }
+}
+
+/// A task resubmitted alone (`sbatch --array=2`) is an array of one task: without `--shard`
+/// it runs the whole sweep as shard 0/1 into `shard_2.json`. The sweep warns (even with
+/// --quiet), and merge-results refuses the set naming that file and the likely cause, writing
+/// no output and leaving an existing one untouched.
+#[test]
+fn a_task_resubmitted_alone_is_named_by_the_merge_error() {
+    let dir = scratch("sweep_resubmitted");
+    let common = [
+        "sweep",
+        "--quiet",
+        "--scenario",
+        "urgent_merge",
+        "--planner",
+        "pf-iso",
+        "--runs",
+        "3",
+        "--seed",
+        "9",
+    ];
+    for index in 0..3 {
+        let json = dir.join(format!("shard_{index}.json"));
+        let id = index.to_string();
+        let mut args = common.to_vec();
+        args.extend(["--json", p(&json)]);
+        // Task 2 as `sbatch --array=2` runs it: ID = MIN = MAX = 2, COUNT = 1.
+        let env: Vec<(&str, &str)> = if index == 2 {
+            vec![
+                ("SLURM_ARRAY_TASK_ID", "2"),
+                ("SLURM_ARRAY_TASK_COUNT", "1"),
+                ("SLURM_ARRAY_TASK_MIN", "2"),
+                ("SLURM_ARRAY_TASK_MAX", "2"),
+            ]
+        } else {
+            vec![
+                ("SLURM_ARRAY_TASK_ID", id.as_str()),
+                ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ]
+        };
+        let out = merge_sim(&args, &env);
+        assert!(out.status.success(), "{}", stderr(&out));
+        if index == 2 {
+            assert!(
+                stderr(&out).contains("SLURM_ARRAY_TASK_COUNT = 1")
+                    && stderr(&out).contains("--shard i/n"),
+                "{}",
+                stderr(&out)
+            );
+            assert_eq!(read_json(&json)["shard"], "0/1");
+        }
+    }
+    let merged_jsonl = dir.join("merged.jsonl");
+    let merged_json = dir.join("merged.json");
+    std::fs::write(&merged_jsonl, "kept\n").unwrap();
+    // Whichever file comes first, the error names shard_2.json and the cure.
+    for files in [
+        ["shard_0.json", "shard_1.json", "shard_2.json"],
+        ["shard_2.json", "shard_0.json", "shard_1.json"],
+    ] {
+        let paths: Vec<String> = files.iter().map(|f| p(&dir.join(f)).to_string()).collect();
+        let mut args = vec!["merge-results"];
+        args.extend(paths.iter().map(String::as_str));
+        args.extend(["--json", p(&merged_json), "--jsonl", p(&merged_jsonl)]);
+        let out = merge_sim(&args, &[]);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        let err = stderr(&out);
+        for needle in [
+            "shard_2.json says it is shard 0/1",
+            "sbatch --array",
+            "--shard i/3",
+            "scontrol requeue",
+        ] {
+            assert!(err.contains(needle), "{needle:?} not in {err}");
+        }
+        assert_eq!(std::fs::read_to_string(&merged_jsonl).unwrap(), "kept\n");
+        assert!(!merged_json.exists());
+    }
+    // Run again with the shard count explicit, the set merges.
+    let json = dir.join("shard_2.json");
+    let mut args = common.to_vec();
+    args.extend(["--shard", "2/3", "--json", p(&json)]);
+    let out = merge_sim(&args, &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let shard_files: Vec<String> = (0..3)
+        .map(|i| p(&dir.join(format!("shard_{i}.json"))).to_string())
+        .collect();
+    let mut args = vec!["merge-results", "--quiet"];
+    args.extend(shard_files.iter().map(String::as_str));
+    args.extend(["--jsonl", p(&merged_jsonl)]);
+    let out = merge_sim(&args, &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let instances: Vec<u64> = jsonl_lines(&merged_jsonl)
+        .iter()
+        .map(|r| r["instance"].as_u64().unwrap())
+        .collect();
+    assert_eq!(instances, [0, 1, 2]);
+}

@@ -1,7 +1,66 @@
 //! Merging the shards of one sweep into the aggregate of the whole (`merge_sim merge-results`).
 
 use super::paired::check_paired;
-use super::{PairedSweepSummary, Shard, SweepError, SweepReport, SweepSummary, instance_seed};
+use super::rows::JsonlLine;
+use super::{
+    PairedSweepSummary, Shard, SweepError, SweepIdentity, SweepReport, SweepSummary, instance_seed,
+};
+
+/// The JSONL text (one line per run, each ending in a newline) of a whole sweep's rows as
+/// `merge_sim merge-results --jsonl` writes them: in instance order, then in the sweep's planner
+/// order (the baseline first) — the rows of the unsharded sweep's `--jsonl`, sorted — each with
+/// the whole sweep's identity. `wall_time_s` is null: a shard's `--json` keeps no per-run wall
+/// times.
+pub fn merged_jsonl(report: &SweepReport) -> Result<String, SweepError> {
+    let summaries = report.summaries();
+    let Some(first) = summaries.first() else {
+        return Err(SweepError::Invalid("no planner in the merged sweep".into()));
+    };
+    let planners = report.planners();
+    let identity = SweepIdentity {
+        planner: planners.join(","),
+        planners,
+        ..first.identity()
+    };
+    let mut text = String::new();
+    for row in report.rows() {
+        let line = serde_json::to_string(&JsonlLine {
+            scenario: &identity.scenario,
+            scenario_fingerprint: &identity.scenario_fingerprint,
+            params: &identity.params,
+            planners: &identity.planners,
+            sweep_seed: identity.seed,
+            total_runs: identity.total_runs,
+            row,
+            wall_time_s: None,
+        })
+        .map_err(|e| {
+            SweepError::Invalid(format!(
+                "instance {} ({}): cannot write its row: {e}",
+                row.instance, row.planner
+            ))
+        })?;
+        text.push_str(&line);
+        text.push('\n');
+    }
+    Ok(text)
+}
+
+/// Why a shard file may carry the wrong shard count: a Slurm array task resubmitted on its own
+/// (`sbatch --array=2 script`) is an array of one task, so without `--shard` it ran the whole
+/// sweep as shard 0/1. `origin` is the odd file, `count` its shard count, `expected` the others'.
+fn shard_count_hint(origin: &str, count: u64, expected: u64) -> String {
+    if count == 1 && expected > 1 {
+        format!(
+            " ({origin} says it is shard 0/1, the whole sweep: was this task run without the \
+             shard count, e.g. resubmitted with `sbatch --array=N` (an array of one task)? run \
+             that shard again with --shard i/{expected} explicitly, or requeue the original \
+             array task: `scontrol requeue JOBID_N`)"
+        )
+    } else {
+        String::new()
+    }
+}
 
 /// Combines the `--json` reports of the shards of one sweep (`(origin, report)`), single- or
 /// multi-planner: a multi-planner sweep is merged planner by planner ([`merge_shards`]) and its
@@ -99,8 +158,20 @@ pub fn merge_shards(parts: Vec<(String, SweepSummary)>) -> Result<SweepSummary, 
         ];
         for (name, expected, found) in fields {
             if expected != found {
+                // Name the file that holds the odd count 1 (a whole sweep), whichever came first.
+                let (odd, odd_count, other_count) = if count == 1 {
+                    (first_origin.as_str(), count, part.shard.count)
+                } else {
+                    (origin.as_str(), part.shard.count, count)
+                };
+                let hint = if name == "shard count" {
+                    shard_count_hint(odd, odd_count, other_count)
+                } else {
+                    String::new()
+                };
                 return Err(SweepError::Invalid(format!(
-                    "{origin}: {name} = {found} differs from {first_origin} ({expected}): not a shard of the same sweep"
+                    "{origin}: {name} = {found} differs from {first_origin} ({expected}): not a \
+                     shard of the same sweep{hint}"
                 )));
             }
         }
@@ -151,7 +222,8 @@ pub fn merge_shards(parts: Vec<(String, SweepSummary)>) -> Result<SweepSummary, 
         .collect();
     if !missing.is_empty() {
         return Err(SweepError::Invalid(format!(
-            "missing shards: {}",
+            "missing shards: {} (run each again with `merge_sim sweep ... --shard i/{count}`, or \
+             requeue its array task: `scontrol requeue JOBID_i`)",
             missing.join(", ")
         )));
     }

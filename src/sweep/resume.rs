@@ -110,7 +110,7 @@ pub fn read_jsonl(
         }
         runs.push(FinishedRun {
             row: record.row,
-            wall_time_s: record.wall_time_s,
+            wall_time_s: record.wall_time_s.unwrap_or(0.0),
         });
     }
     Ok(ResumedRows {

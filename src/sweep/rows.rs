@@ -190,7 +190,9 @@ pub(super) struct JsonlLine<'a> {
     pub(super) total_runs: u64,
     #[serde(flatten)]
     pub(super) row: &'a RunRow,
-    pub(super) wall_time_s: f64,
+    /// `None` (null) in the rows `merge-results --jsonl` writes: a shard's `--json` keeps no
+    /// per-run wall times.
+    pub(super) wall_time_s: Option<f64>,
 }
 
 /// A JSONL line read back (`--resume`): the identity of its sweep, the row and its wall time.
@@ -214,6 +216,8 @@ pub struct JsonlRecord {
     /// The run.
     #[serde(flatten)]
     pub row: RunRow,
-    /// Wall time of the run (s).
-    pub wall_time_s: f64,
+    /// Wall time of the run (s); null (`None`) in the rows `merge_sim merge-results --jsonl`
+    /// writes, as a shard's `--json` file keeps no per-run wall times.
+    #[serde(default)]
+    pub wall_time_s: Option<f64>,
 }

@@ -1,12 +1,13 @@
 //! Splitting a sweep into disjoint shards, for job arrays on a cluster.
 //!
 //! Shard `i/n` (0-based, `0 ≤ i < n`) runs the contiguous block of instances
-//! `[⌊i·N/n⌋, ⌊(i+1)·N/n⌋)` of a sweep of N runs: the blocks partition `0..N`, differ in size by
-//! at most one, and concatenating the shards' JSONL files in shard order gives the unsharded
-//! file's rows in order.
+//! `[⌊i·N/n⌋, ⌊(i+1)·N/n⌋)` of a sweep of N runs: the blocks partition `0..N` and differ in size
+//! by at most one. `merge_sim merge-results --jsonl` writes the shards' rows in instance order
+//! (each shard's JSONL is in completion order).
 //!
 //! Where a shard comes from, first match wins:
-//! 1. `--shard i/n`;
+//! 1. `--shard i/n` (what cluster scripts should pass: a Slurm task resubmitted alone is an
+//!    array of one task, which 2. reads as the whole sweep);
 //! 2. a Slurm job array: `SLURM_ARRAY_TASK_ID`, `SLURM_ARRAY_TASK_COUNT`, and if set
 //!    `SLURM_ARRAY_TASK_MIN` / `SLURM_ARRAY_TASK_STEP` (so `--array=1-8` and `--array=0-14:2`
 //!    work: i = (ID − MIN) / STEP);

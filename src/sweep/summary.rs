@@ -92,7 +92,7 @@ pub fn jsonl_line(
         sweep_seed: identity.seed,
         total_runs: identity.total_runs,
         row,
-        wall_time_s,
+        wall_time_s: Some(wall_time_s),
     })
 }
 

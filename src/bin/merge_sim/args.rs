@@ -34,7 +34,9 @@ pub(crate) enum Command {
     /// statistics (instance i runs with seed SplitMix64::derive(--seed, i); replay it alone with
     /// `merge_sim run --scenario S --planner P --seed <that seed>`).
     Sweep(SweepArgs),
-    /// Combine the --json files of the shards of one sweep into the aggregate of the whole sweep.
+    /// Combine the --json files of the shards of one sweep into the aggregate of the whole sweep
+    /// (--json) and its rows in instance order (--jsonl, --parquet), after checking that every
+    /// shard is there exactly once, complete and of the same sweep.
     MergeResults(MergeResultsArgs),
     /// Sensitivity grid: every planner on the same instances under {obstacles predicted in
     /// Eq. 7 on/off} × {sub-steps on/off} × path time gap τ × interaction time gap τ_I, with
@@ -208,7 +210,10 @@ pub(crate) struct SweepArgs {
     pub(crate) seed: u64,
     /// Run only shard i of n (0-based): instances [⌊i·N/n⌋, ⌊(i+1)·N/n⌋). Default: from a Slurm
     /// job array (SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_COUNT), a Kubernetes Indexed Job
-    /// (JOB_COMPLETION_INDEX with MERGESIM_SHARD_COUNT), else the whole sweep (0/1).
+    /// (JOB_COMPLETION_INDEX with MERGESIM_SHARD_COUNT), else the whole sweep (0/1). On a
+    /// cluster pass it explicitly (`--shard "$SLURM_ARRAY_TASK_ID/$SHARDS"`): a task resubmitted
+    /// alone (`sbatch --array=2`) is an array of one task and would run the whole sweep. The
+    /// sweep prints its shard on stderr, even with --quiet.
     #[arg(long, value_name = "i/n", value_parser = parse_shard)]
     pub(crate) shard: Option<mergesim::sweep::Shard>,
     /// Write the aggregate JSON here (with per-run samples, so shards can be merged).
@@ -239,12 +244,24 @@ pub(crate) struct SweepArgs {
 
 #[derive(Args, Debug)]
 pub(crate) struct MergeResultsArgs {
-    /// The `sweep --json` files of every shard of one sweep, in any order.
+    /// The `sweep --json` files of every shard of one sweep, in any order. Each shard i/n must
+    /// be given exactly once, complete, and of the same sweep (scenario and its fingerprint,
+    /// parameters, planners, --runs, --seed, shard count); otherwise nothing is written and
+    /// the error names the file (exit 2).
     #[arg(required = true, value_name = "SHARD_JSON")]
     pub(crate) inputs: Vec<PathBuf>,
-    /// Write the aggregate of the whole sweep here.
+    /// Write the aggregate of the whole sweep here: what the unsharded sweep's --json holds,
+    /// except `wall_time_s`, here the sum of the shards' wall times (the time the shards
+    /// took together, not the elapsed time of the array).
     #[arg(long, value_name = "PATH")]
     pub(crate) json: Option<PathBuf>,
+    /// Write the rows of the whole sweep as JSONL here, in instance order (then in the sweep's
+    /// planner order): the unsharded sweep's --jsonl rows, sorted, each with the whole sweep's
+    /// identity; `wall_time_s` is null (a shard's --json keeps no per-run wall times). Taken
+    /// from the validated shard files, so unlike `cat shard_*.jsonl` it is checked and ordered.
+    /// An existing regular file is replaced, as with --json and --parquet.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) jsonl: Option<PathBuf>,
     /// Write the rows of the whole sweep as one Parquet file here (as `sweep --parquet`).
     #[arg(long, value_name = "PATH")]
     pub(crate) parquet: Option<PathBuf>,

@@ -39,9 +39,20 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
     )?;
     let shard = match args.shard {
         Some(shard) => shard,
-        None => Shard::from_environment(|name| std::env::var(name).ok())
-            .map_err(input)?
-            .unwrap_or(Shard::WHOLE),
+        None => {
+            let shard = Shard::from_environment(|name| std::env::var(name).ok()).map_err(input)?;
+            if let (Some(shard), Ok(count)) = (shard, std::env::var("SLURM_ARRAY_TASK_COUNT"))
+                && shard.count == 1
+            {
+                // Printed even with --quiet: it explains a shard file of the wrong count.
+                eprintln!(
+                    "warning: SLURM_ARRAY_TASK_COUNT = {count}: an array of one task runs the \
+                     whole sweep (shard 0/1); to run one shard of a sweep again (e.g. after \
+                     `sbatch --array=2`) pass --shard i/n, or requeue the task instead"
+                );
+            }
+            shard.unwrap_or(Shard::WHOLE)
+        }
     };
     // `--planner P` and `--planners P` are the same sweep.
     let planners = match args.planner {
@@ -300,6 +311,7 @@ pub(crate) fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> 
     check_outputs(
         &[
             (args.json.as_deref(), "--json"),
+            (args.jsonl.as_deref(), "--jsonl"),
             (args.parquet.as_deref(), "--parquet"),
         ],
         &inputs,
@@ -316,9 +328,24 @@ pub(crate) fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> 
         parts.push((origin, part));
     }
     let merged = merge_reports(parts).map_err(sweep_failure)?;
+    // Every output is made before any is written: a bad row writes none of them.
+    let rows = match &args.jsonl {
+        Some(path) => Some((
+            path,
+            mergesim::sweep::merged_jsonl(&merged).map_err(run_failure)?,
+        )),
+        None => None,
+    };
     write_report(&merged, args.json.as_deref(), args.parquet.as_deref())?;
+    if let Some((path, text)) = rows {
+        write_output(path, &text)?;
+    }
     if !args.quiet {
         out!("{}", merged.table());
+        outln!(
+            "(wall time: the sum of the {} shards' wall times, not the elapsed time)",
+            args.inputs.len()
+        );
     }
     Ok(())
 }
