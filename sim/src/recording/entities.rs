@@ -105,10 +105,10 @@ impl Recorder {
             rgba.extend_from_slice(&[r, g, b, 255]);
         }
         let width = f64::from(steps);
-        // The bar is 256 × 24 scene units: x = position on the scale × 256.
+        // The bar is 256 × 12 scene units: x = position on the scale × 256.
         active.stream.log_static(
             "legend/field_scale",
-            &Transform3D::from_scale([1.0, 24.0, 1.0]),
+            &Transform3D::from_scale([1.0, 12.0, 1.0]),
         )?;
         active.stream.log_static(
             "legend/field_scale/bar",
@@ -121,14 +121,14 @@ impl Recorder {
         };
         active.stream.log_static(
             "legend/ticks",
-            &Points2D::new(ticks.iter().map(|(t, _)| [(t * width) as f32, 30.0]))
+            &Points2D::new(ticks.iter().map(|(t, _)| [(t * width) as f32, 18.0]))
                 .with_labels(ticks.iter().map(|(_, v)| format!("{v}")))
                 .with_colors([Color::from_rgb(230, 230, 230)])
                 .with_radii([2.0]),
         )?;
         active.stream.log_static(
             "legend/title",
-            &Points2D::new([[0.0, -8.0]])
+            &Points2D::new([[0.5 * width as f32, -6.0]])
                 .with_labels([format!(
                     "potential U ({scale_name} scale, {} to {}; clamped outside)",
                     range[0], range[1]
@@ -181,6 +181,7 @@ impl Recorder {
             &Boxes2D::from_centers_and_half_sizes(centers, half_sizes)
                 .with_colors(colors)
                 .with_labels(names.iter().map(String::as_str))
+                .with_radii([self.params.vehicle_outline_radius_m as f32])
                 .with_draw_order(DRAW_VEHICLES),
         )?;
         if let Some(body) = names
@@ -322,13 +323,17 @@ impl Recorder {
                 reason: "grid too large".into(),
             });
         };
+        let alpha = (self.params.field_opacity.clamp(0.0, 1.0) * 255.0).round() as u8;
         let mut rgba = Vec::with_capacity(4 * values.len());
-        for t in normalize_field(values, self.params.field_color_scale, self.params.field_range)
-        {
+        for t in normalize_field(
+            values,
+            self.params.field_color_scale,
+            self.params.field_range,
+        ) {
             match t {
                 Some(t) => {
                     let [r, g, b] = viridis(t);
-                    rgba.extend_from_slice(&[r, g, b, 255]);
+                    rgba.extend_from_slice(&[r, g, b, alpha]);
                 }
                 None => rgba.extend_from_slice(&[0, 0, 0, 0]),
             }
@@ -336,8 +341,11 @@ impl Recorder {
         let path = format!("world/fields/{}", entity_part(name));
         active.stream.log(
             path.as_str(),
-            &Transform3D::from_translation([x0_m as f32, y0_m as f32, 0.0])
-                .with_scale([cell_m as f32, cell_m as f32, 1.0]),
+            &Transform3D::from_translation([x0_m as f32, y0_m as f32, 0.0]).with_scale([
+                cell_m as f32,
+                cell_m as f32,
+                1.0,
+            ]),
         )?;
         active.stream.log(
             path,

@@ -129,8 +129,8 @@ impl Default for FollowWindow {
     fn default() -> Self {
         Self {
             behind_m: 30.0,
-            ahead_m: 70.0,
-            side_m: 10.0,
+            ahead_m: 50.0,
+            side_m: 6.0,
         }
     }
 }
@@ -150,9 +150,14 @@ pub struct RecorderParams {
     /// Colour scale of potential fields.
     pub field_color_scale: FieldColorScale,
     /// The fixed value range [lo, hi] of the field's colour scale (the potential U is
-    /// dimensionless). The default covers the fields of the built-in scenarios: the bowl of the
-    /// attraction and the obstacles reach ~10², the road edges beyond 10³ (clamped).
+    /// dimensionless). The default covers the recorded fields of the built-in scenarios
+    /// (measured 2026-12-02 on `urgent_merge` and `dense_merge`: 0.01 to 201, median ~35; the
+    /// attractive bowl dominates far from the vehicle); larger values are clamped.
     pub field_range: [f64; 2],
+    /// Opacity of the field images, 0 to 1 (the road lines and vehicles stay visible over it).
+    pub field_opacity: f64,
+    /// Radius of the vehicles' box outlines (m).
+    pub vehicle_outline_radius_m: f64,
     /// Radius of the road lines (m).
     pub road_line_radius_m: f64,
     /// Radius of the path lines (m).
@@ -182,7 +187,9 @@ impl Default for RecorderParams {
             follow: "ego".into(),
             follow_window_m: FollowWindow::default(),
             field_color_scale: FieldColorScale::Log,
-            field_range: [0.0, 1000.0],
+            field_range: [0.0, 200.0],
+            field_opacity: 0.6,
+            vehicle_outline_radius_m: 0.15,
             road_line_radius_m: 0.08,
             path_line_radius_m: 0.06,
             detail_vehicles: Some(DEFAULT_DETAIL_VEHICLES),

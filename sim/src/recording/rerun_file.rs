@@ -4,15 +4,17 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-use rerun::external::re_sdk_types::blueprint::archetypes::{PlotLegend, ScalarAxis, VisualBounds2D};
-use rerun::blueprint::components::Corner2D;
+use rerun::blueprint::components::{Corner2D, PanelState};
 use rerun::blueprint::{
-    Blueprint, BlueprintActivation, ContainerLike, Horizontal, Spatial2DView, TextLogView,
-    TimeSeriesView, Vertical,
+    Blueprint, BlueprintActivation, BlueprintPanel, ContainerLike, Horizontal, SelectionPanel,
+    Spatial2DView, TextLogView, TimePanel, TimeSeriesView, Vertical,
 };
 use rerun::components::{Color, TextLogLevel};
 use rerun::datatypes::{Range1D, Range2D};
 use rerun::external::re_log_types::{BlueprintActivationCommand, EntityPath};
+use rerun::external::re_sdk_types::blueprint::archetypes::{
+    PlotLegend, ScalarAxis, VisualBounds2D,
+};
 use rerun::log::LogMsg;
 use rerun::{AsComponents, RecordingStream, RecordingStreamBuilder, StoreKind};
 
@@ -72,8 +74,8 @@ fn blueprint(params: &RecorderParams) -> (Blueprint, Vec<ViewProperty>) {
         view_entry(Spatial2DView::new("Field scale (potential U)").with_origin("/legend"));
     bounds(
         legend_id,
-        [-10.0, f64::from(super::entities::COLOR_BAR_STEPS) + 20.0],
-        [-14.0, 40.0],
+        [-10.0, f64::from(super::entities::COLOR_BAR_STEPS) + 10.0],
+        [-12.0, 24.0],
     );
     let left = Vertical::new([
         follow,
@@ -81,7 +83,7 @@ fn blueprint(params: &RecorderParams) -> (Blueprint, Vec<ViewProperty>) {
         legend,
         TextLogView::new("Events").with_origin("/events").into(),
     ])
-    .with_row_shares([5.0, 2.0, 1.0, 2.0]);
+    .with_row_shares([3.0, 1.5, 1.2, 1.5]);
     let mut plots: Vec<ContainerLike> = Vec::new();
     for plot in &params.blueprint_series {
         let (id, view) = view_entry(
@@ -99,7 +101,7 @@ fn blueprint(params: &RecorderParams) -> (Blueprint, Vec<ViewProperty>) {
             props.push(ViewProperty {
                 view: id,
                 archetype: "PlotLegend",
-                value: Box::new(PlotLegend::new().with_corner(Corner2D::LeftBottom)),
+                value: Box::new(PlotLegend::new().with_corner(Corner2D::RightBottom)),
             });
         }
         plots.push(view);
@@ -109,9 +111,18 @@ fn blueprint(params: &RecorderParams) -> (Blueprint, Vec<ViewProperty>) {
     } else {
         Horizontal::new([left.into(), Vertical::new(plots).into()]).with_column_shares([3.0, 2.0])
     };
+    // The side panels start collapsed (the views get the room) and the time panel as its
+    // compact bar on `sim_time`; every panel opens with one click.
     let bp = Blueprint::new(root)
         .with_auto_views(false)
-        .with_auto_layout(false);
+        .with_auto_layout(false)
+        .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
+        .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
+        .with_time_panel(
+            TimePanel::new()
+                .with_state(PanelState::Collapsed)
+                .with_timeline(SIM_TIMELINE),
+        );
     (bp, props)
 }
 
