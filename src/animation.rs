@@ -353,8 +353,7 @@ fn draw_frame(
     });
     let crash = collisions
         .iter()
-        .filter(|c| c.t_s <= t_s + 1e-9)
-        .last()
+        .rfind(|c| c.t_s <= t_s + 1e-9)
         .map_or(String::new(), |c| format!("  COLLISION at {:.2} s", c.t_s));
     root.draw(&Text::new(
         format!("{title}  t = {t_s:5.2} s{speed}{crash}"),

@@ -284,6 +284,7 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
     let show_progress = std::io::stderr().is_terminal();
     let mut summaries = Vec::new();
     let mut time_series = Vec::new();
+    let mut collisions = Vec::new();
     for &kind in &args.planners {
         let what = Simulation {
             planner: Some(kind),
@@ -295,6 +296,7 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
         let finished = simulate(&scenario, &what, interrupt)?;
         summaries.push(finished.summary);
         time_series.push(finished.outcome.time_series);
+        collisions.push(finished.outcome.safety.collisions);
     }
     out!("{}", comparison_table(&summaries));
     if let Some(path) = &args.json {
@@ -307,9 +309,11 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
         let series: Vec<mergesim::plots::PlannerSeries<'_>> = summaries
             .iter()
             .zip(&time_series)
-            .map(|(s, rows)| mergesim::plots::PlannerSeries {
+            .zip(&collisions)
+            .map(|((s, rows), collisions)| mergesim::plots::PlannerSeries {
                 planner: &s.planner,
                 rows,
+                collisions,
             })
             .collect();
         let road = &scenario.instance(args.seed).sim.road;
