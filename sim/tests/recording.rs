@@ -175,14 +175,20 @@ fn recording_is_written_on_finish_and_decodes() {
     assert!(has("Transform3D:scale"));
     assert!(has("SeriesPoints:markers"));
     assert!(has("TextLog:level"));
-    assert!(!has("Boxes3D") && !has("Mesh3D"), "3D archetypes left: {descriptors:?}");
+    assert!(
+        !has("Boxes3D") && !has("Mesh3D"),
+        "3D archetypes left: {descriptors:?}"
+    );
     // The follow frame moves at every logged instant (the ego is in every log_vehicles call).
     assert_eq!(follow_rows, 20);
     // 20 instants at 50 ms on the duration timeline (nanoseconds).
     assert_eq!(sim_times_ns.len(), 20);
     assert!(sim_times_ns.contains(&950_000_000));
     assert!(blueprint_msgs > 0, "no blueprint in the file");
-    assert_eq!(activations, 1, "the blueprint is activated once, as the default");
+    assert_eq!(
+        activations, 1,
+        "the blueprint is activated once, as the default"
+    );
     // Three 2D views with visual bounds (follow, whole road, colour bar), one y axis and one
     // legend corner per time-series view, written into the blueprint store.
     let count = |suffix: &str| {
