@@ -5,7 +5,7 @@
 #
 #   apt-get install -y xvfb imagemagick mesa-vulkan-drivers libgl1-mesa-dri xdotool optipng pngquant
 #   pip install rerun-sdk==0.36.3
-#   scripts/rerun_screenshot.sh [TIME_S]          # default 10.77 s (just after the lane change)
+#   scripts/rerun_screenshot.sh [TIME_S]          # default 10.77 s (just after the lane change); ~55 s
 #
 # Notes: Xvfb must run with `-extension Composite` (without it the viewer's window stays
 # black), only WGPU_BACKEND=vulkan works (the GL backend lacks the R32Float target), and the
@@ -20,7 +20,12 @@ work="$(mktemp -d /tmp/mergesim_shot.XXXXXX)"
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 mkdir -p "$work/home" "$work/xdg" && chmod 700 "$work/xdg"
 
-cargo run --release --bin merge_sim -- --quiet --rrd "$work/urgent.rrd"
+# MERGE_SIM=/path/to/merge_sim uses that binary instead of `cargo run`.
+if [ -n "${MERGE_SIM:-}" ]; then
+    "$MERGE_SIM" --quiet --rrd "$work/urgent.rrd"
+else
+    cargo run --release --bin merge_sim -- --quiet --rrd "$work/urgent.rrd"
+fi
 
 Xvfb "$display" -screen 0 1600x900x24 -extension Composite >"$work/xvfb.log" 2>&1 &
 xvfb_pid=$!
@@ -37,15 +42,12 @@ rerun_bin="$(python3 -c 'import rerun_cli, os; print(os.path.join(os.path.dirnam
 HOME="$work/home" DISPLAY="$display" WGPU_BACKEND=vulkan XDG_RUNTIME_DIR="$work/xdg" \
     "$rerun_bin" --port "$port" "$work/urgent.rrd" >"$work/rerun.log" 2>&1 &
 viewer_pid=$!
-sleep 20
-# The recording plays when opened: pause it (the play/pause button at the bar's left end).
-DISPLAY="$display" xdotool mousemove 20 885
-sleep 0.5
-DISPLAY="$display" xdotool click 1
-sleep 1
-# The collapsed time panel's bar spans x = 268..1400 px for the run's 0..25 s (1600 px wide
+# The viewer plays the recording once when it opens (25 s of simulated time at 1x) and stops,
+# paused, at its end; a click on the bar then moves the time cursor without playing.
+sleep 40
+# The collapsed time panel's bar spans x = 258..1390 px for the run's 0..25 s (1600 px wide
 # window); a click there moves the time cursor.
-x=$(python3 -c "print(round(268 + (1400 - 268) * $time_s / 25.0))")
+x=$(python3 -c "print(round(258 + (1390 - 258) * $time_s / 25.0))")
 DISPLAY="$display" xdotool mousemove "$x" 885
 sleep 0.5
 DISPLAY="$display" xdotool click 1

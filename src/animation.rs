@@ -44,8 +44,8 @@ impl Default for GifParams {
         Self {
             fps: 10.0,
             width_px: 800,
-            behind_m: 25.0,
-            ahead_m: 55.0,
+            behind_m: 30.0,
+            ahead_m: 50.0,
             margin_m: 2.0,
         }
     }
