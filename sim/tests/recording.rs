@@ -110,6 +110,7 @@ fn recording_is_written_on_finish_and_decodes() {
     let mut blueprint_descriptors = BTreeSet::new();
     let mut activations = 0;
     let mut follow_rows = 0;
+    let mut follow_xy: Vec<[f32; 2]> = Vec::new();
     for msg in DecoderApp::decode_lazy(BufReader::new(file)) {
         let msg = msg.unwrap();
         if let LogMsg::BlueprintActivationCommand(cmd) = &msg {
@@ -129,6 +130,10 @@ fn recording_is_written_on_finish_and_decodes() {
             entities.insert(chunk.entity_path().to_string());
             if chunk.entity_path().to_string() == "/world/follow" {
                 follow_rows += chunk.num_rows();
+                let id = rerun::Transform3D::descriptor_translation().component;
+                for row in chunk.iter_component::<rerun::components::Translation3D>(id) {
+                    follow_xy.extend(row.iter().map(|t| [t.0.0[0], t.0.0[1]]));
+                }
             }
             for d in chunk.component_descriptors() {
                 descriptors.insert(d.to_string());
@@ -181,6 +186,15 @@ fn recording_is_written_on_finish_and_decodes() {
     );
     // The follow frame moves at every logged instant (the ego is in every log_vehicles call).
     assert_eq!(follow_rows, 20);
+    // ... at the ego's position (x = 20 t, y = 1.75 in `log_run`), never the obstacle's.
+    follow_xy.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    assert_eq!(follow_xy.len(), 20);
+    for (k, [x, y]) in follow_xy.iter().enumerate() {
+        assert!(
+            (x - k as f32).abs() < 1e-4 && (y - 1.75).abs() < 1e-6,
+            "{follow_xy:?}"
+        );
+    }
     // 20 instants at 50 ms on the duration timeline (nanoseconds).
     assert_eq!(sim_times_ns.len(), 20);
     assert!(sim_times_ns.contains(&950_000_000));
