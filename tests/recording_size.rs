@@ -52,6 +52,6 @@ fn detail_is_limited_by_default_and_the_estimate_is_close() {
     let default_detail = RecorderParams::default().detail_vehicles;
     let estimate = estimated_bytes(&platoon.sim, &platoon.vehicles, default_detail);
     assert!(estimate < 200e6, "{estimate}");
-    // In full detail its received paths alone (50 × 49 per instant) make it ~480 MB.
+    // In full detail its received paths (50 × 49 per instant) make it ~500 MB.
     assert!(estimated_bytes(&platoon.sim, &platoon.vehicles, None) > 400e6);
 }
