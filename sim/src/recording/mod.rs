@@ -143,7 +143,9 @@ pub struct RecorderParams {
     pub blueprint: bool,
     /// The time-series views of the blueprint (in this order).
     pub blueprint_series: Vec<SeriesPlot>,
-    /// The vehicle the follow view keeps at its centre (`merge_sim run --follow`).
+    /// The vehicle the follow view keeps in its window (`merge_sim run --follow`, which refuses
+    /// an unknown name). If no logged vehicle has this name, `world/follow` is never logged and
+    /// the follow view shows nothing.
     pub follow: String,
     /// The follow view's window around that vehicle.
     pub follow_window_m: FollowWindow,
