@@ -6,6 +6,7 @@
 //! [`scenarios`] (scenario files).
 #![warn(missing_docs)]
 
+pub mod animation;
 pub mod exact_seed;
 pub mod experiment;
 pub mod grid;

@@ -2,8 +2,9 @@
 //! paths of both vehicles, one panel per planner) and Fig. 4 (sideslip, yaw, yaw rate and speed
 //! over time, one line per planner) as PNG, plus the data behind them as one CSV.
 //!
-//! Rendering uses plotters' bitmap backend; text goes through `ab_glyph` with DejaVu Sans Mono
-//! embedded from `docs/fonts` (Bitstream Vera licence, `docs/fonts/LICENSE-DejaVu.txt`), so no
+//! Rendering uses plotters' bitmap backend; text goes through `ab_glyph` with DejaVu Sans
+//! embedded from `docs/fonts` (proportional, so a minus sign sits next to its number; Bitstream
+//! Vera licence, `docs/fonts/LICENSE-DejaVu.txt`), so no
 //! system font library (fontconfig, freetype) is needed to build or run.
 //!
 //! Every file is written whole or not at all ([`crate::output::write_atomically`]).
@@ -17,6 +18,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 use sim::TimeSeriesRow;
+use sim::safety::CollisionEvent;
 
 use crate::output::{temporary_path, write_atomically};
 
@@ -26,8 +28,8 @@ mod paths;
 use motion_states::draw_states;
 use paths::draw_paths;
 
-/// The embedded font (DejaVu Sans Mono).
-const FONT_TTF: &[u8] = include_bytes!("../docs/fonts/DejaVuSansMono.ttf");
+/// The embedded font (DejaVu Sans).
+const FONT_TTF: &[u8] = include_bytes!("../docs/fonts/DejaVuSans.ttf");
 
 /// Font family name the figures ask for; the embedded font is registered under it.
 const FONT_FAMILY: &str = "sans-serif";
@@ -68,6 +70,46 @@ pub struct PlannerSeries<'a> {
     pub planner: &'a str,
     /// The run's time series (every vehicle, interleaved as the world logs them).
     pub rows: &'a [TimeSeriesRow],
+    /// The run's collisions (vehicle ids = order of first appearance in `rows`), marked on the
+    /// figures.
+    pub collisions: &'a [CollisionEvent],
+}
+
+/// Line style of the `index`-th of `count` planners: earlier planners are drawn wider and
+/// later ones on top, so identical runs (PF-CS and PF-SP often are) stay visible as a line
+/// inside a wider one.
+pub(crate) fn planner_stroke(index: usize, count: usize) -> u32 {
+    2 + count.saturating_sub(index + 1).min(3) as u32
+}
+
+/// Colour of the `index`-th vehicle (by id): the recording's and the GIF's palette.
+pub(crate) fn vehicle_rgb(index: usize) -> RGBColor {
+    let [r, g, b] = sim::recording::vehicle_color(u32::try_from(index).unwrap_or(u32::MAX));
+    RGBColor(r, g, b)
+}
+
+/// The position and time of each vehicle of `rows` at each collision of `collisions`: the
+/// first logged instant at or after the collision.
+pub(crate) fn collision_marks(
+    rows: &[TimeSeriesRow],
+    collisions: &[CollisionEvent],
+) -> Vec<(f64, String, f64, f64)> {
+    let names = vehicle_names(rows);
+    let mut marks = Vec::new();
+    for c in collisions {
+        for id in [c.id_a, c.id_b] {
+            let Some(name) = names.get(id as usize) else {
+                continue;
+            };
+            if let Some(r) = rows
+                .iter()
+                .find(|r| r.vehicle == *name && r.t_s >= c.t_s - 1e-9)
+            {
+                marks.push((c.t_s, name.clone(), r.x_m, r.y_m));
+            }
+        }
+    }
+    marks
 }
 
 /// Why a figure could not be written.
@@ -90,7 +132,7 @@ pub enum PlotError {
         message: String,
     },
     /// The embedded font could not be parsed.
-    #[error("the embedded font docs/fonts/DejaVuSansMono.ttf could not be loaded")]
+    #[error("the embedded font docs/fonts/DejaVuSans.ttf could not be loaded")]
     Font,
     /// There is nothing to draw.
     #[error("nothing to plot: {0}")]
@@ -337,6 +379,18 @@ mod tests {
     }
 
     #[test]
+    fn earlier_planners_are_wider_and_vehicles_have_distinct_colours() {
+        let widths: Vec<u32> = (0..4).map(|i| planner_stroke(i, 4)).collect();
+        assert!(widths.windows(2).all(|w| w[0] > w[1]), "{widths:?}");
+        let colors: Vec<RGBColor> = (0..4).map(vehicle_rgb).collect();
+        for i in 0..4 {
+            for j in 0..i {
+                assert_ne!(colors[i], colors[j]);
+            }
+        }
+    }
+
+    #[test]
     fn vehicle_names_keep_first_appearance_order() {
         let rows = [
             row(0.0, "ego", 0.0, 1.75),
@@ -353,10 +407,12 @@ mod tests {
             PlannerSeries {
                 planner: "pf-cs",
                 rows: &rows,
+                collisions: &[],
             },
             PlannerSeries {
                 planner: "pf-iso",
                 rows: &rows[..1],
+                collisions: &[],
             },
         ]);
         let lines: Vec<&str> = text.lines().collect();
@@ -381,14 +437,24 @@ mod tests {
                 ]
             })
             .collect();
+        let crash = [CollisionEvent {
+            t_s: 2.0,
+            id_a: 0,
+            id_b: 1,
+            t_contact_estimate_s: None,
+            relative_speed_mps: 5.0,
+        }];
+        assert_eq!(collision_marks(&rows, &crash).len(), 2);
         let series = [
             PlannerSeries {
                 planner: "pf-cs",
                 rows: &rows,
+                collisions: &crash,
             },
             PlannerSeries {
                 planner: "pf-iso",
                 rows: &rows,
+                collisions: &[],
             },
         ];
         let size = FigureSize {

@@ -389,7 +389,7 @@ fn run_profile_says_where_the_wall_time_went() {
 fn a_large_recording_is_announced_before_it_is_written() {
     let dir = scratch("large_recording");
     let rrd = dir.join("platoon.rrd");
-    // Fields and received paths of all 50 vehicles: about 1 GB. Stopped by SIGTERM after
+    // Fields and received paths of all 50 vehicles: about 500 MB. Stopped by SIGTERM after
     // three seconds, long before it is written.
     let out = Command::new("timeout")
         .args(["-s", "TERM", "3"])

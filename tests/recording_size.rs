@@ -37,8 +37,9 @@ fn detail_is_limited_by_default_and_the_estimate_is_close() {
     scenario.sim.duration_s = 10.0;
     let (all, all_estimate) = record(&scenario, None, "size_all");
     let (two, two_estimate) = record(&scenario, Some(2), "size_two");
-    // Fields and received paths of 4 of 6 vehicles fewer: much smaller.
-    assert!(two < 0.6 * all, "{two} vs {all}");
+    // Fields and received paths of 4 of 6 vehicles fewer: much smaller (mostly the received
+    // paths: a field is a ~1.7 kB image since the 2D recording, 62 kB as a 3D mesh before).
+    assert!(two < 0.7 * all, "{two} vs {all}");
     for (written, estimate) in [(all, all_estimate), (two, two_estimate)] {
         let ratio = estimate / written;
         assert!(
@@ -51,5 +52,6 @@ fn detail_is_limited_by_default_and_the_estimate_is_close() {
     let default_detail = RecorderParams::default().detail_vehicles;
     let estimate = estimated_bytes(&platoon.sim, &platoon.vehicles, default_detail);
     assert!(estimate < 200e6, "{estimate}");
-    assert!(estimated_bytes(&platoon.sim, &platoon.vehicles, None) > 500e6);
+    // In full detail its received paths (50 × 49 per instant) make it ~500 MB.
+    assert!(estimated_bytes(&platoon.sim, &platoon.vehicles, None) > 400e6);
 }

@@ -106,15 +106,35 @@ fn recording_is_written_on_finish_and_decodes() {
     let mut descriptors = BTreeSet::new();
     let mut sim_times_ns = BTreeSet::new();
     let mut blueprint_msgs = 0;
+    let mut blueprint_entities = Vec::new();
+    let mut blueprint_descriptors = BTreeSet::new();
+    let mut activations = 0;
+    let mut follow_rows = 0;
+    let mut follow_xy: Vec<[f32; 2]> = Vec::new();
     for msg in DecoderApp::decode_lazy(BufReader::new(file)) {
         let msg = msg.unwrap();
+        if let LogMsg::BlueprintActivationCommand(cmd) = &msg {
+            assert!(cmd.make_default);
+            activations += 1;
+        }
         if let LogMsg::ArrowMsg(store_id, arrow_msg) = &msg {
+            let chunk = Chunk::from_arrow_msg(arrow_msg).unwrap();
             if store_id.kind() == StoreKind::Blueprint {
                 blueprint_msgs += 1;
+                blueprint_entities.push(chunk.entity_path().to_string());
+                for d in chunk.component_descriptors() {
+                    blueprint_descriptors.insert(d.to_string());
+                }
                 continue;
             }
-            let chunk = Chunk::from_arrow_msg(arrow_msg).unwrap();
             entities.insert(chunk.entity_path().to_string());
+            if chunk.entity_path().to_string() == "/world/follow" {
+                follow_rows += chunk.num_rows();
+                let id = rerun::Transform3D::descriptor_translation().component;
+                for row in chunk.iter_component::<rerun::components::Translation3D>(id) {
+                    follow_xy.extend(row.iter().map(|t| [t.0.0[0], t.0.0[1]]));
+                }
+            }
             for d in chunk.component_descriptors() {
                 descriptors.insert(d.to_string());
             }
@@ -126,7 +146,12 @@ fn recording_is_written_on_finish_and_decodes() {
         }
     }
     for entity in [
-        "/world",
+        "/world/overview",
+        "/world/follow",
+        "/legend/field_scale",
+        "/legend/field_scale/bar",
+        "/legend/ticks",
+        "/plots/speed_mps/events/error",
         "/world/road/edges",
         "/world/road/divider",
         "/world/road/merge_section",
@@ -147,13 +172,52 @@ fn recording_is_written_on_finish_and_decodes() {
     // The NaN planned speed is a gap, not a logged value.
     assert!(!entities.contains("/plots/planned_speed_mps/ego"));
     let has = |needle: &str| descriptors.iter().any(|d| d.contains(needle));
-    assert!(has("Boxes3D:quaternions"), "{descriptors:?}");
-    assert!(has("Mesh3D:vertex_colors"));
+    // Top-down 2D: boxes, lines and the field as an image placed by its transform.
+    assert!(has("Boxes2D:half_sizes"), "{descriptors:?}");
+    assert!(has("LineStrips2D:strips"));
+    assert!(has("Image:buffer"));
+    assert!(has("Transform3D:translation"));
+    assert!(has("Transform3D:scale"));
+    assert!(has("SeriesPoints:markers"));
     assert!(has("TextLog:level"));
+    assert!(
+        !has("Boxes3D") && !has("Mesh3D"),
+        "3D archetypes left: {descriptors:?}"
+    );
+    // The follow frame moves at every logged instant (the ego is in every log_vehicles call).
+    assert_eq!(follow_rows, 20);
+    // ... at the ego's position (x = 20 t, y = 1.75 in `log_run`), never the obstacle's.
+    follow_xy.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    assert_eq!(follow_xy.len(), 20);
+    for (k, [x, y]) in follow_xy.iter().enumerate() {
+        assert!(
+            (x - k as f32).abs() < 1e-4 && (y - 1.75).abs() < 1e-6,
+            "{follow_xy:?}"
+        );
+    }
     // 20 instants at 50 ms on the duration timeline (nanoseconds).
     assert_eq!(sim_times_ns.len(), 20);
     assert!(sim_times_ns.contains(&950_000_000));
     assert!(blueprint_msgs > 0, "no blueprint in the file");
+    assert_eq!(
+        activations, 1,
+        "the blueprint is activated once, as the default"
+    );
+    // Three 2D views with visual bounds (follow, whole road, colour bar), one y axis and one
+    // legend corner per time-series view, written into the blueprint store.
+    let count = |suffix: &str| {
+        blueprint_entities
+            .iter()
+            .filter(|e| e.ends_with(suffix))
+            .count()
+    };
+    assert_eq!(count("/VisualBounds2D"), 3, "{blueprint_entities:?}");
+    assert_eq!(count("/ScalarAxis"), 5);
+    assert_eq!(count("/PlotLegend"), 5);
+    let bp_has = |needle: &str| blueprint_descriptors.iter().any(|d| d.contains(needle));
+    assert!(bp_has("VisualBounds2D:range"), "{blueprint_descriptors:?}");
+    assert!(bp_has("ScalarAxis:range"));
+    assert!(bp_has("ViewBlueprint:space_origin"));
 
     // When a `rerun` CLI of the same version is available, let it verify the file too:
     // MERGESIM_RERUN_CLI=/path/to/rerun cargo test --release -p sim --test recording

@@ -4,7 +4,9 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{DrawResult, PlannerSeries, font, padded_range, planner_color};
+use super::{
+    DrawResult, PlannerSeries, collision_marks, font, padded_range, planner_color, planner_stroke,
+};
 use sim::TimeSeriesRow;
 
 /// The legend box of one panel, in the same style on every figure.
@@ -57,6 +59,7 @@ pub(super) fn draw_states(
         let mut chart = ChartBuilder::on(panel)
             .caption(format!("{vehicle}: {label}"), font(18))
             .margin(8)
+            .margin_right(30)
             .x_label_area_size(34)
             .y_label_area_size(70)
             .build_cartesian_2d(t_range.clone(), y_range)
@@ -71,7 +74,7 @@ pub(super) fn draw_states(
             .map_err(|e| e.to_string())?;
         for (index, s) in series.iter().enumerate() {
             let color = planner_color(s.planner, index);
-            let style = color.stroke_width(2);
+            let style = color.stroke_width(planner_stroke(index, series.len()));
             let points: Vec<(f64, f64)> = s
                 .rows
                 .iter()
@@ -83,6 +86,25 @@ pub(super) fn draw_states(
                 .map_err(|e| e.to_string())?
                 .label(s.planner.to_string())
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
+        }
+        // Collisions of this vehicle: a vertical red line in the planner's run.
+        let y = chart.y_range();
+        let mut labelled = false;
+        for s in series {
+            for (t, _, _, _) in collision_marks(s.rows, s.collisions)
+                .into_iter()
+                .filter(|m| m.1 == vehicle)
+            {
+                let line =
+                    DashedLineSeries::new([(t, y.start), (t, y.end)], 6, 4, RED.stroke_width(2));
+                let anchor = chart.draw_series(line).map_err(|e| e.to_string())?;
+                if !labelled {
+                    labelled = true;
+                    anchor.label("collision").legend(|(x, y)| {
+                        PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2))
+                    });
+                }
+            }
         }
         draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
     }

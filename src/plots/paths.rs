@@ -5,10 +5,11 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::motion_states::draw_legend;
-use super::{DrawResult, PlannerSeries, font, padded_range};
+use super::{DrawResult, PlannerSeries, collision_marks, font, padded_range, vehicle_rgb};
 
 /// Fig. 3: the road (edges, divider, merge section shaded) and each vehicle's path, one panel
-/// per planner; the first vehicle solid, the others dashed.
+/// per planner; the first vehicle solid, the others dashed, in the recording's vehicle colours;
+/// collisions marked with red crosses.
 pub(super) fn draw_paths(
     area: &DrawingArea<BitMapBackend<'_>, Shift>,
     road: &MergeRoad,
@@ -26,6 +27,7 @@ pub(super) fn draw_paths(
         let mut chart = ChartBuilder::on(panel)
             .caption(format!("{}: paths", s.planner), font(20))
             .margin(8)
+            .margin_right(30)
             .x_label_area_size(34)
             .y_label_area_size(56)
             .build_cartesian_2d(x_range.clone(), y_range.clone())
@@ -72,12 +74,7 @@ pub(super) fn draw_paths(
             ))
             .map_err(|e| e.to_string())?;
         for (k, vehicle) in vehicles.iter().enumerate() {
-            let color = if k == 0 {
-                RGBColor(120, 60, 160)
-            } else {
-                let c = Palette99::pick(k + 2).to_rgba();
-                RGBColor(c.0, c.1, c.2)
-            };
+            let color = vehicle_rgb(k);
             let points: Vec<(f64, f64)> = s
                 .rows
                 .iter()
@@ -97,6 +94,19 @@ pub(super) fn draw_paths(
             anchor
                 .label(vehicle.clone())
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
+        }
+        // Collisions: a red cross at each vehicle involved, where it was.
+        let marks = collision_marks(s.rows, s.collisions);
+        if !marks.is_empty() {
+            chart
+                .draw_series(
+                    marks
+                        .iter()
+                        .map(|m| Cross::new((m.2, m.3), 7, RED.stroke_width(3))),
+                )
+                .map_err(|e| e.to_string())?
+                .label("collision")
+                .legend(|(x, y)| Cross::new((x + 10, y), 5, RED.stroke_width(2)));
         }
         draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     }

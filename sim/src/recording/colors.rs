@@ -1,5 +1,5 @@
 //! Colours and names of the recording: the vehicles' palette, the field's viridis scale and its
-//! normalisation, entity-path parts, the yaw as a quaternion.
+//! normalisation on a fixed range and its colour-bar ticks, entity-path parts, the 2D views' frame.
 
 #[cfg(feature = "rerun")]
 use rerun::datatypes::Quaternion;
@@ -57,26 +57,57 @@ pub fn viridis(t: f64) -> [u8; 3] {
     out
 }
 
-/// Maps `values` to [0, 1] with `scale`; non-finite values map to `None`.
-pub fn normalize_field(values: &[f64], scale: FieldColorScale) -> Vec<Option<f64>> {
-    let finite = values.iter().copied().filter(|v| v.is_finite());
-    let min = finite.clone().fold(f64::INFINITY, f64::min);
-    let max = finite.fold(f64::NEG_INFINITY, f64::max);
-    let range = max - min;
+/// Maps `values` to [0, 1] with `scale` on the fixed range `[lo, hi]` (values outside are
+/// clamped); non-finite values map to `None`. A degenerate range (hi ≤ lo, or not finite) maps
+/// every finite value to 0.
+pub fn normalize_field(
+    values: &[f64],
+    scale: FieldColorScale,
+    range: [f64; 2],
+) -> Vec<Option<f64>> {
     values
         .iter()
-        .map(|&v| {
-            if !v.is_finite() {
-                return None;
+        .map(|&v| v.is_finite().then(|| scale_position(v, scale, range)))
+        .collect()
+}
+
+/// Where `v` lies on the colour scale, in [0, 1].
+fn scale_position(v: f64, scale: FieldColorScale, [lo, hi]: [f64; 2]) -> f64 {
+    let span = hi - lo;
+    if !(span.is_finite() && span > 0.0) {
+        return 0.0;
+    }
+    let d = (v - lo).clamp(0.0, span);
+    match scale {
+        FieldColorScale::Linear => d / span,
+        FieldColorScale::Log => d.ln_1p() / span.ln_1p(),
+    }
+}
+
+/// Labelled ticks of the colour bar: (position in [0, 1], value). Linear: five evenly spaced
+/// values; log: lo and lo + 10^k for each power of ten up to the span, and hi.
+pub fn field_scale_ticks(scale: FieldColorScale, range: [f64; 2]) -> Vec<(f64, f64)> {
+    let [lo, hi] = range;
+    let span = hi - lo;
+    if !(span.is_finite() && span > 0.0) {
+        return vec![(0.0, lo)];
+    }
+    let values: Vec<f64> = match scale {
+        FieldColorScale::Linear => (0..5).map(|k| lo + span * f64::from(k) / 4.0).collect(),
+        FieldColorScale::Log => {
+            let mut v = vec![lo];
+            let mut step = 1.0;
+            while step < span * 0.999 {
+                v.push(lo + step);
+                step *= 10.0;
             }
-            if !range.is_finite() || range <= 0.0 {
-                return Some(0.0);
-            }
-            Some(match scale {
-                FieldColorScale::Linear => (v - min) / range,
-                FieldColorScale::Log => (v - min).ln_1p() / range.ln_1p(),
-            })
-        })
+            v.push(hi);
+            v
+        }
+    };
+    values
+        .into_iter()
+        .map(|v| (scale_position(v, scale, range), v))
         .collect()
 }
 
@@ -96,10 +127,11 @@ pub fn entity_part(name: &str) -> String {
     if part.is_empty() { "_".into() } else { part }
 }
 
+/// 180° about X: the frame of the 2D views, in which road Y points up on screen (Rerun's 2D
+/// views draw Y down).
 #[cfg(feature = "rerun")]
-pub(crate) fn yaw_quaternion(yaw_rad: f64) -> Quaternion {
-    let half = 0.5 * yaw_rad;
-    Quaternion::from_xyzw([0.0, 0.0, half.sin() as f32, half.cos() as f32])
+pub(crate) fn y_up_quaternion() -> Quaternion {
+    Quaternion::from_xyzw([1.0, 0.0, 0.0, 0.0])
 }
 
 #[cfg(test)]
@@ -123,16 +155,43 @@ mod tests {
 
     #[test]
     fn normalize_field_maps_min_and_max() {
-        let v = [2.0, 4.0, f64::NAN, 10.0];
-        let lin = normalize_field(&v, FieldColorScale::Linear);
-        assert_eq!(lin, vec![Some(0.0), Some(0.25), None, Some(1.0)]);
-        let log = normalize_field(&v, FieldColorScale::Log);
+        let v = [2.0, 4.0, f64::NAN, 10.0, 50.0, -1.0];
+        let lin = normalize_field(&v, FieldColorScale::Linear, [2.0, 10.0]);
+        assert_eq!(
+            lin,
+            vec![Some(0.0), Some(0.25), None, Some(1.0), Some(1.0), Some(0.0)]
+        );
+        let log = normalize_field(&v, FieldColorScale::Log, [2.0, 10.0]);
         let expected = 3.0_f64.ln() / 9.0_f64.ln();
         assert!((log[1].unwrap() - expected).abs() < 1e-12);
         assert_eq!(log[3], Some(1.0));
         assert_eq!(
-            normalize_field(&[5.0, 5.0], FieldColorScale::Log),
+            normalize_field(&[5.0, 5.0], FieldColorScale::Log, [3.0, 3.0]),
             vec![Some(0.0); 2]
+        );
+    }
+
+    #[test]
+    fn the_scale_is_fixed_not_per_snapshot() {
+        // The same value gets the same colour whatever else is in the snapshot.
+        let a = normalize_field(&[10.0, 20.0], FieldColorScale::Log, [0.0, 1000.0]);
+        let b = normalize_field(&[10.0, 900.0], FieldColorScale::Log, [0.0, 1000.0]);
+        assert_eq!(a[0], b[0]);
+        assert!(a[0].is_some_and(|t| t > 0.0 && t < 1.0));
+    }
+
+    #[test]
+    fn ticks_span_the_bar() {
+        let t = field_scale_ticks(FieldColorScale::Log, [0.0, 200.0]);
+        let values: Vec<f64> = t.iter().map(|p| p.1).collect();
+        assert_eq!(values, vec![0.0, 1.0, 10.0, 100.0, 200.0]);
+        assert_eq!(t[0].0, 0.0);
+        assert_eq!(t[4].0, 1.0);
+        assert!(t.windows(2).all(|w| w[0].0 < w[1].0));
+        let lin = field_scale_ticks(FieldColorScale::Linear, [0.0, 8.0]);
+        assert_eq!(
+            lin.iter().map(|p| p.0).collect::<Vec<_>>(),
+            vec![0.0, 0.25, 0.5, 0.75, 1.0]
         );
     }
 
@@ -141,15 +200,5 @@ mod tests {
         assert_eq!(entity_part("ego car/1"), "ego_car_1");
         assert_eq!(entity_part("yaw_rate_radps"), "yaw_rate_radps");
         assert_eq!(entity_part(""), "_");
-    }
-
-    #[test]
-    fn yaw_quaternion_rotates_x_onto_heading() {
-        let yaw = 0.7_f64;
-        let [x, y, z, w] = yaw_quaternion(yaw).xyzw().map(f64::from);
-        // Rotate (1, 0, 0) by q: first column of the rotation matrix.
-        let rx = 1.0 - 2.0 * (y * y + z * z);
-        let ry = 2.0 * (x * y + w * z);
-        assert!((rx - yaw.cos()).abs() < 1e-6 && (ry - yaw.sin()).abs() < 1e-6);
     }
 }

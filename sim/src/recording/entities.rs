@@ -1,17 +1,44 @@
 //! What the recording logs: the road, the vehicles' boxes, planned and received paths, the
-//! potential fields, time series and events.
+//! potential fields, the follow frame, the field's colour bar, time series and events.
 
 use mergesim_types::{MergeRoad, PathPoint, SharedLocalPath};
-use rerun::components::{Color, FillMode};
-use rerun::{Boxes3D, LineStrips3D, Mesh3D, Points3D, Scalars, SeriesLines, TextLog};
+use rerun::components::{Color, MarkerShape};
+use rerun::{
+    Boxes2D, Image, LineStrips2D, Points2D, Scalars, SeriesLines, SeriesPoints, TextLog,
+    Transform3D,
+};
 
 use crate::body_state::BodyState;
 
-use super::colors::{entity_part, normalize_field, vehicle_color, viridis, yaw_quaternion};
+use super::colors::{
+    entity_part, field_scale_ticks, normalize_field, vehicle_color, viridis, y_up_quaternion,
+};
 use super::{EventLevel, Recorder, RecordingError, check_finite};
 
+/// Draw orders of the 2D layers (higher is drawn on top).
+const DRAW_MERGE_SECTION: f32 = -20.0;
+const DRAW_FIELD: f32 = -10.0;
+const DRAW_ROAD: f32 = 0.0;
+const DRAW_RECEIVED: f32 = 5.0;
+const DRAW_PLANNED: f32 = 10.0;
+const DRAW_VEHICLES: f32 = 20.0;
+
+/// Width of the colour bar (pixels of its image; one per step of the scale).
+pub(super) const COLOR_BAR_STEPS: u32 = 256;
+
+/// Colour of event markers by level.
+fn event_color(level: EventLevel) -> Color {
+    match level {
+        EventLevel::Debug => Color::from_rgb(150, 150, 150),
+        EventLevel::Info => Color::from_rgb(60, 140, 230),
+        EventLevel::Warn => Color::from_rgb(240, 170, 20),
+        EventLevel::Error => Color::from_rgb(220, 30, 30),
+    }
+}
+
 impl Recorder {
-    /// Logs the road (static): edges, lane divider and the merge section.
+    /// Logs the road (static): edges, lane divider and the merge section; and the static frame
+    /// of the whole-road view.
     pub fn log_road(&mut self, road: &MergeRoad) -> Result<(), RecordingError> {
         let Some(active) = &self.active else {
             return Ok(());
@@ -20,48 +47,99 @@ impl Recorder {
             call: "log_road",
             reason: e.to_string(),
         })?;
-        let z = self.params.line_z_m as f32;
-        let to_3d = |p: &[f64; 2]| [p[0] as f32, p[1] as f32, z];
-        let upper: Vec<[f32; 3]> = road.upper_edge_polyline().iter().map(to_3d).collect();
-        let lower: Vec<[f32; 3]> = road.lower_edge_polyline().iter().map(to_3d).collect();
+        let to_2d = |p: &[f64; 2]| [p[0] as f32, p[1] as f32];
+        let upper: Vec<[f32; 2]> = road.upper_edge_polyline().iter().map(to_2d).collect();
+        let lower: Vec<[f32; 2]> = road.lower_edge_polyline().iter().map(to_2d).collect();
         active.stream.log_static(
             "world/road/edges",
-            &LineStrips3D::new([upper, lower])
+            &LineStrips2D::new([upper, lower])
                 .with_colors([Color::from_rgb(230, 230, 230)])
                 .with_radii([self.params.road_line_radius_m as f32])
-                .with_labels(["upper edge", "lower edge"]),
+                .with_draw_order(DRAW_ROAD),
         )?;
         let y_lane = road.y_lane_m() as f32;
         active.stream.log_static(
             "world/road/divider",
-            &LineStrips3D::new([[
-                [road.start_x_m as f32, y_lane, z],
-                [road.merge_end_x_m as f32, y_lane, z],
+            &LineStrips2D::new([[
+                [road.start_x_m as f32, y_lane],
+                [road.merge_end_x_m as f32, y_lane],
             ]])
             .with_colors([Color::from_rgb(240, 200, 60)])
-            .with_radii([0.5 * self.params.road_line_radius_m as f32]),
+            .with_radii([0.5 * self.params.road_line_radius_m as f32])
+            .with_draw_order(DRAW_ROAD),
         )?;
         let half_length = 0.5 * (road.merge_end_x_m - road.merge_start_x_m);
         let half_width = 0.5 * (road.y_upper_m() - road.y_bottom_m);
         active.stream.log_static(
             "world/road/merge_section",
-            &Boxes3D::from_centers_and_half_sizes(
+            &Boxes2D::from_centers_and_half_sizes(
                 [[
                     (road.merge_start_x_m + half_length) as f32,
                     (road.y_bottom_m + half_width) as f32,
-                    // Under the potential-field grids, so it does not tint them.
-                    (self.params.field_z_m - 0.1) as f32,
                 ]],
-                [[half_length as f32, half_width as f32, 0.005]],
+                [[half_length as f32, half_width as f32]],
             )
             .with_colors([Color::from_unmultiplied_rgba(255, 140, 0, 50)])
-            .with_fill_mode(FillMode::Solid)
-            .with_labels(["merge section"]),
+            .with_draw_order(DRAW_MERGE_SECTION),
+        )?;
+        active.stream.log_static(
+            "world/overview",
+            &Transform3D::from_rotation(y_up_quaternion()),
         )?;
         Ok(())
     }
 
-    /// Logs the vehicles as oriented boxes; `names[i]` labels `bodies[i]`.
+    /// Logs the field's colour bar (static): a gradient image one unit high and
+    /// `COLOR_BAR_STEPS` wide, with labelled ticks under it.
+    pub(super) fn log_field_legend(&self) -> Result<(), RecordingError> {
+        let Some(active) = &self.active else {
+            return Ok(());
+        };
+        let scale = self.params.field_color_scale;
+        let range = self.params.field_range;
+        check_finite("log_field_legend", "field_range", &range)?;
+        let steps = COLOR_BAR_STEPS;
+        let mut rgba = Vec::with_capacity(4 * steps as usize);
+        for k in 0..steps {
+            let [r, g, b] = viridis(f64::from(k) / f64::from(steps - 1));
+            rgba.extend_from_slice(&[r, g, b, 255]);
+        }
+        let width = f64::from(steps);
+        // The bar is 256 × 12 scene units: x = position on the scale × 256.
+        active.stream.log_static(
+            "legend/field_scale",
+            &Transform3D::from_scale([1.0, 12.0, 1.0]),
+        )?;
+        active.stream.log_static(
+            "legend/field_scale/bar",
+            &Image::from_rgba32(rgba, [steps, 1]),
+        )?;
+        let ticks = field_scale_ticks(scale, range);
+        let scale_name = match scale {
+            super::FieldColorScale::Linear => "linear",
+            super::FieldColorScale::Log => "log",
+        };
+        active.stream.log_static(
+            "legend/ticks",
+            &Points2D::new(ticks.iter().map(|(t, _)| [(t * width) as f32, 18.0]))
+                .with_labels(ticks.iter().map(|(_, v)| format!("{v}")))
+                .with_colors([Color::from_rgb(230, 230, 230)])
+                .with_radii([2.0]),
+        )?;
+        active.stream.log_static(
+            "legend/title",
+            &Points2D::new([[0.5 * width as f32, -6.0]])
+                .with_labels([format!(
+                    "potential U ({scale_name} scale, {} to {}; clamped outside)",
+                    range[0], range[1]
+                )])
+                .with_radii([0.1]),
+        )?;
+        Ok(())
+    }
+
+    /// Logs the vehicles as boxes; `names[i]` labels `bodies[i]`. Also moves the follow frame
+    /// to the vehicle named [`super::RecorderParams::follow`] if it is among them.
     pub fn log_vehicles(
         &mut self,
         bodies: &[BodyState],
@@ -84,16 +162,10 @@ impl Recorder {
                 });
             }
         }
-        let centers = bodies
+        let centers = bodies.iter().map(|b| [b.x_m as f32, b.y_m as f32]);
+        let half_sizes = bodies
             .iter()
-            .map(|b| [b.x_m as f32, b.y_m as f32, (0.5 * b.height_m) as f32]);
-        let half_sizes = bodies.iter().map(|b| {
-            [
-                (0.5 * b.length_m) as f32,
-                (0.5 * b.width_m) as f32,
-                (0.5 * b.height_m) as f32,
-            ]
-        });
+            .map(|b| [(0.5 * b.length_m) as f32, (0.5 * b.width_m) as f32]);
         let colors: Vec<Color> = bodies
             .iter()
             .map(|b| {
@@ -106,15 +178,27 @@ impl Recorder {
         }
         active.stream.log(
             "world/vehicles",
-            &Boxes3D::from_centers_and_half_sizes(centers, half_sizes)
-                .with_quaternions(bodies.iter().map(|b| yaw_quaternion(b.yaw_rad)))
+            &Boxes2D::from_centers_and_half_sizes(centers, half_sizes)
                 .with_colors(colors)
                 .with_labels(names.iter().map(String::as_str))
-                .with_fill_mode(FillMode::Solid),
+                .with_radii([self.params.vehicle_outline_radius_m as f32])
+                .with_draw_order(DRAW_VEHICLES),
         )?;
+        if let Some(body) = names
+            .iter()
+            .position(|n| *n == self.params.follow)
+            .and_then(|i| bodies.get(i))
+        {
+            active.stream.log(
+                "world/follow",
+                &Transform3D::from_translation_rotation(
+                    [body.x_m as f32, body.y_m as f32, 0.0],
+                    y_up_quaternion(),
+                ),
+            )?;
+        }
         Ok(())
     }
-
     fn color_of(&self, name: &str) -> Color {
         self.active
             .as_ref()
@@ -135,11 +219,7 @@ impl Recorder {
             check_finite("log_planned_path", "a path point", &[p.x_m, p.y_m])?;
         }
         let color = self.color_of(name);
-        let z = self.params.line_z_m as f32;
-        let points: Vec<[f32; 3]> = path
-            .iter()
-            .map(|p| [p.x_m as f32, p.y_m as f32, z])
-            .collect();
+        let points: Vec<[f32; 2]> = path.iter().map(|p| [p.x_m as f32, p.y_m as f32]).collect();
         let base = format!("world/paths/{}", entity_part(name));
         let radius = self.params.path_line_radius_m as f32;
         let Some(active) = &self.active else {
@@ -147,15 +227,17 @@ impl Recorder {
         };
         active.stream.log(
             format!("{base}/planned"),
-            &LineStrips3D::new([points.clone()])
+            &LineStrips2D::new([points.clone()])
                 .with_colors([color])
-                .with_radii([radius]),
+                .with_radii([radius])
+                .with_draw_order(DRAW_PLANNED),
         )?;
         active.stream.log(
             format!("{base}/planned_points"),
-            &Points3D::new(points)
+            &Points2D::new(points)
                 .with_colors([color])
-                .with_radii([2.5 * radius]),
+                .with_radii([2.5 * radius])
+                .with_draw_order(DRAW_PLANNED),
         )?;
         Ok(())
     }
@@ -174,11 +256,10 @@ impl Recorder {
                 check_finite("log_received_paths", "a waypoint", &[w.x_m, w.y_m])?;
             }
         }
-        let z = (self.params.line_z_m + 0.02) as f32;
         let strips = paths.iter().map(|slp| {
             slp.waypoints
                 .iter()
-                .map(|w| [w.x_m as f32, w.y_m as f32, z])
+                .map(|w| [w.x_m as f32, w.y_m as f32])
                 .collect::<Vec<_>>()
         });
         let colors = paths.iter().map(|slp| {
@@ -190,20 +271,22 @@ impl Recorder {
             .map(|slp| format!("SLP from {}", slp.vehicle_id));
         active.stream.log(
             format!("world/paths/{}/received", entity_part(name)),
-            &LineStrips3D::new(strips)
+            &LineStrips2D::new(strips)
                 .with_colors(colors)
                 .with_labels(labels)
-                .with_radii([0.5 * self.params.path_line_radius_m as f32]),
+                .with_radii([0.5 * self.params.path_line_radius_m as f32])
+                .with_draw_order(DRAW_RECEIVED),
         )?;
         Ok(())
     }
 
-    /// Logs a potential field sampled on a grid as a colour-mapped mesh lying on the road.
+    /// Logs a potential field sampled on a grid as an image lying on the road, coloured on the
+    /// recording's fixed scale.
     ///
     /// Image convention: the grid's corner is (x0_m, y0_m), cells are `cell_m` square, and
-    /// `values[j * width + i]` is the value of cell (i, j), whose centre
-    /// (x0_m + (i + ½)·cell_m, y0_m + (j + ½)·cell_m) becomes a mesh vertex; the grid needs at
-    /// least 2 × 2 cells. Non-finite values are drawn transparent.
+    /// `values[j * width + i]` is the value of cell (i, j), which covers
+    /// [x0_m + i·cell_m, x0_m + (i + 1)·cell_m] × [y0_m + j·cell_m, y0_m + (j + 1)·cell_m]; the
+    /// grid needs at least 2 × 2 cells. Non-finite values are drawn transparent.
     #[allow(clippy::too_many_arguments)]
     pub fn log_field(
         &mut self,
@@ -234,54 +317,39 @@ impl Recorder {
                 ),
             });
         }
-        let (Ok(w), Ok(_)) = (u32::try_from(width), u32::try_from(values.len())) else {
+        let (Ok(w), Ok(h)) = (u32::try_from(width), u32::try_from(height)) else {
             return Err(RecordingError::InvalidInput {
                 call: "log_field",
                 reason: "grid too large".into(),
             });
         };
-        // One height per vehicle (in name order), so overlapping fields do not z-fight.
-        let layer = active
-            .name_colors
-            .keys()
-            .position(|n| n == name)
-            .unwrap_or(active.name_colors.len());
-        let z = (self.params.field_z_m - 0.01 * layer as f64) as f32;
-        let positions = (0..height).flat_map(|j| {
-            (0..width).map(move |i| {
-                [
-                    (x0_m + (i as f64 + 0.5) * cell_m) as f32,
-                    (y0_m + (j as f64 + 0.5) * cell_m) as f32,
-                    z,
-                ]
-            })
-        });
-        let colors: Vec<Color> = normalize_field(values, self.params.field_color_scale)
-            .into_iter()
-            .map(|t| match t {
+        let alpha = (self.params.field_opacity.clamp(0.0, 1.0) * 255.0).round() as u8;
+        let mut rgba = Vec::with_capacity(4 * values.len());
+        for t in normalize_field(
+            values,
+            self.params.field_color_scale,
+            self.params.field_range,
+        ) {
+            match t {
                 Some(t) => {
                     let [r, g, b] = viridis(t);
-                    Color::from_rgb(r, g, b)
+                    rgba.extend_from_slice(&[r, g, b, alpha]);
                 }
-                None => Color::TRANSPARENT,
-            })
-            .collect();
-        let mut triangles = Vec::with_capacity(2 * (width - 1) * (height - 1));
-        for j in 0..(height as u32 - 1) {
-            for i in 0..(w - 1) {
-                let v00 = j * w + i;
-                let v10 = v00 + 1;
-                let v01 = v00 + w;
-                let v11 = v01 + 1;
-                triangles.push([v00, v10, v11]);
-                triangles.push([v00, v11, v01]);
+                None => rgba.extend_from_slice(&[0, 0, 0, 0]),
             }
         }
+        let path = format!("world/fields/{}", entity_part(name));
         active.stream.log(
-            format!("world/fields/{}", entity_part(name)),
-            &Mesh3D::new(positions)
-                .with_vertex_colors(colors)
-                .with_triangle_indices(triangles),
+            path.as_str(),
+            &Transform3D::from_translation([x0_m as f32, y0_m as f32, 0.0]).with_scale([
+                cell_m as f32,
+                cell_m as f32,
+                1.0,
+            ]),
+        )?;
+        active.stream.log(
+            path,
+            &Image::from_rgba32(rgba, [w, h]).with_draw_order(DRAW_FIELD),
         )?;
         Ok(())
     }
@@ -318,15 +386,38 @@ impl Recorder {
         Ok(())
     }
 
-    /// Logs an event line (collision, near miss, planner fallback) at the current time.
+    /// Logs an event line (collision, near miss, lane change, planner fallback) at the current
+    /// time, and a marker for it at the bottom of every time-series plot of the blueprint.
     pub fn log_event(&mut self, text: &str, level: EventLevel) -> Result<(), RecordingError> {
-        let Some(active) = &self.active else {
+        let Some(active) = &mut self.active else {
             return Ok(());
         };
         active.stream.log(
             "events",
             &TextLog::new(text).with_level(level.as_text_log_level()),
         )?;
+        if level == EventLevel::Debug {
+            return Ok(());
+        }
+        for plot in &self.params.blueprint_series {
+            let Some([y_min, _]) = plot.y_range else {
+                continue;
+            };
+            let level_name = level.name();
+            let path = format!("plots/{}/events/{level_name}", entity_part(&plot.series));
+            if !active.styled_series.contains(&path) {
+                active.stream.log_static(
+                    path.as_str(),
+                    &SeriesPoints::new()
+                        .with_names([format!("{level_name} event")])
+                        .with_colors([event_color(level)])
+                        .with_markers([MarkerShape::Up])
+                        .with_marker_sizes([8.0]),
+                )?;
+                active.styled_series.insert(path.clone());
+            }
+            active.stream.log(path, &Scalars::single(y_min))?;
+        }
         Ok(())
     }
 }

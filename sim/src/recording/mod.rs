@@ -10,31 +10,52 @@
 //! removes its temporary file, so no half-written recording is ever left under the final name.
 //!
 //! # Entity layout
+//! Everything is drawn top-down in 2D, in road coordinates (X forward along the road, Y to the
+//! left, metres); the views turn Y upwards on screen.
+//!
 //! | entity | archetype | content |
 //! |---|---|---|
-//! | `world` | `ViewCoordinates` (static) | X forward along the road, Y left, Z up |
-//! | `world/road/edges` | `LineStrips3D` (static) | upper edge, piecewise lower edge (Eq. 3) |
-//! | `world/road/divider` | `LineStrips3D` (static) | lane divider up to the end of the merge |
-//! | `world/road/merge_section` | `Boxes3D` (static) | translucent slab over the merge section |
-//! | `world/vehicles` | `Boxes3D` | oriented boxes, label and colour per vehicle |
-//! | `world/paths/<name>/planned` (+ `_points`) | `LineStrips3D`, `Points3D` | planned path |
-//! | `world/paths/<name>/received` | `LineStrips3D` | shared local paths received over V2V |
-//! | `world/fields/<name>` | `Mesh3D` | a potential field, colour-mapped, lying on the road |
+//! | `world/road/edges` | `LineStrips2D` (static) | upper edge, piecewise lower edge (Eq. 3) |
+//! | `world/road/divider` | `LineStrips2D` (static) | lane divider up to the end of the merge |
+//! | `world/road/merge_section` | `Boxes2D` (static) | translucent box over the merge section |
+//! | `world/vehicles` | `Boxes2D` | one box (length × width, axis-aligned), label and colour per vehicle |
+//! | `world/paths/<name>/planned` (+ `_points`) | `LineStrips2D`, `Points2D` | planned path |
+//! | `world/paths/<name>/received` | `LineStrips2D` | shared local paths received over V2V |
+//! | `world/fields/<name>` | `Image` (RGBA) + `Transform3D` | a potential field on the fixed colour scale, under the rest |
+//! | `world/follow` | `Transform3D` | a frame at the followed vehicle, Y flipped: the follow view's origin |
+//! | `world/overview` | `Transform3D` (static) | the road frame, Y flipped: the whole-road view's origin |
+//! | `legend/field_scale` | `Image`, `Points2D` (static) | the field's colour bar and its labelled ticks |
 //! | `plots/<series>/<name>` | `Scalars` (+ static `SeriesLines`) | one plot per series |
-//! | `events` | `TextLog` | collisions, near misses, planner fallbacks |
+//! | `plots/<series>/events/<level>` | `Scalars` (+ static `SeriesPoints`) | a marker per event (info, warn, error), at the plot's lower y bound |
+//! | `events` | `TextLog` | collisions, near misses, lane changes, planner fallbacks |
 //!
 //! All temporal data is on the duration timeline `sim_time` (seconds of simulated time).
+//! Vehicles are axis-aligned boxes (`Boxes2D` has no rotation): on a highway |yaw| stays below
+//! ~0.1 rad, which moves a corner by less than 0.25 m; the yaw is in its own plot.
+//!
+//! # Following a vehicle
+//! Rerun 0.36 has no follow camera and a view's visual bounds are a blueprint value, not a
+//! temporal one. The recording therefore logs, at every logged instant, the transform of
+//! `world/follow` (translation = the followed vehicle's position, rotation = 180° about X, which
+//! turns Y up on screen). The "Follow" view has `world/follow` as its origin, so Rerun draws
+//! everything under `world` in that frame: the followed vehicle stays at (0, 0) and the visual
+//! bounds ([`RecorderParams::follow_window_m`]) form a fixed window around it. The "Whole road"
+//! view has the static frame `world/overview` as its origin.
 //!
 //! # Potential fields
-//! A field is logged as a `Mesh3D` grid in world coordinates, its vertices at the sample points
-//! and coloured with viridis, lying just below the road plane: it renders in the same 3D view as
-//! the road, the vehicles and the paths, at the right place and scale, with no camera or
-//! image-to-world transform needed (a 2D image would need its own view and lose the overlay).
+//! A field is an RGBA image placed on the road by its transform (translation = the grid's corner,
+//! scale = the cell size), under the vehicles and paths. Its colours are on one **fixed** scale
+//! for the whole run and every vehicle ([`FieldColorScale`], [`RecorderParams::field_range`]),
+//! so a colour is a value: the colour bar `legend/field_scale` (its own view, "Field scale")
+//! shows the scale with labelled ticks; values outside the range are clamped.
 //!
 //! # Blueprint
-//! The 0.36 Rust SDK supports blueprints (marked experimental): the file starts with a default
-//! layout — the 3D road view over the event log on the left, one time-series view per series on
-//! the right. Disable it with [`RecorderParams::blueprint`].
+//! The file starts with a default layout: the follow view over the whole-road view, the field's
+//! colour bar and the event log on the left, one time-series view per series (title with units,
+//! fixed y range, legend in a corner) on the right. The 0.36 Rust SDK's `Spatial2DView` and
+//! `TimeSeriesView` builders cannot set visual bounds or axes, so those view properties are
+//! logged into the blueprint store next to the views it writes (`rerun_file::blueprint_messages`).
+//! Disable the blueprint with [`RecorderParams::blueprint`].
 
 mod colors;
 #[cfg(feature = "rerun")]
@@ -58,15 +79,60 @@ use without_rerun::ActiveRecording;
 /// Name of the timeline all temporal data is logged on.
 pub const SIM_TIMELINE: &str = "sim_time";
 
-/// How field values are mapped to colours.
+/// How field values are mapped to colours, between the fixed bounds
+/// [`RecorderParams::field_range`] = [lo, hi] (values outside are clamped).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FieldColorScale {
-    /// (v − min) / (max − min).
+    /// (v − lo) / (hi − lo).
     Linear,
-    /// ln(1 + v − min) / ln(1 + max − min): potential fields span orders of magnitude near the
+    /// ln(1 + v − lo) / ln(1 + hi − lo): potential fields span orders of magnitude near the
     /// road edges (Eq. 3 diverges there), so a linear map would show one bright line.
     Log,
+}
+
+/// One time-series view of the blueprint.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeriesPlot {
+    /// The series (`plots/<series>/...`).
+    pub series: String,
+    /// The view's title, with the unit.
+    pub title: String,
+    /// The initial y range [min, max] in the series' unit (`None`: fit the data).
+    pub y_range: Option<[f64; 2]>,
+}
+
+impl SeriesPlot {
+    fn new(series: &str, title: &str, y_range: [f64; 2]) -> Self {
+        Self {
+            series: series.into(),
+            title: title.into(),
+            y_range: Some(y_range),
+        }
+    }
+}
+
+/// The window of the follow view around the followed vehicle (m, road axes).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FollowWindow {
+    /// Road shown behind the vehicle (m).
+    pub behind_m: f64,
+    /// Road shown ahead of the vehicle (m).
+    pub ahead_m: f64,
+    /// Road shown to each side of the vehicle (m).
+    pub side_m: f64,
+}
+
+impl Default for FollowWindow {
+    fn default() -> Self {
+        Self {
+            behind_m: 30.0,
+            ahead_m: 50.0,
+            side_m: 6.0,
+        }
+    }
 }
 
 /// Options of the recording.
@@ -75,14 +141,25 @@ pub enum FieldColorScale {
 pub struct RecorderParams {
     /// Write a default viewer layout into the file.
     pub blueprint: bool,
-    /// The series that get their own time-series view in the blueprint (in this order).
-    pub blueprint_series: Vec<String>,
+    /// The time-series views of the blueprint (in this order).
+    pub blueprint_series: Vec<SeriesPlot>,
+    /// The vehicle the follow view keeps in its window (`merge_sim run --follow`, which refuses
+    /// an unknown name). If no logged vehicle has this name, `world/follow` is never logged and
+    /// the follow view shows nothing.
+    pub follow: String,
+    /// The follow view's window around that vehicle.
+    pub follow_window_m: FollowWindow,
     /// Colour scale of potential fields.
     pub field_color_scale: FieldColorScale,
-    /// Height at which fields are drawn (m); slightly below the road so boxes stay visible.
-    pub field_z_m: f64,
-    /// Height at which road lines and paths are drawn (m).
-    pub line_z_m: f64,
+    /// The fixed value range [lo, hi] of the field's colour scale (the potential U is
+    /// dimensionless). The default covers the recorded fields of the built-in scenarios
+    /// (measured 2026-12-02 on `urgent_merge` and `dense_merge`: 0.01 to 201, median ~35; the
+    /// attractive bowl dominates far from the vehicle); larger values are clamped.
+    pub field_range: [f64; 2],
+    /// Opacity of the field images, 0 to 1 (the road lines and vehicles stay visible over it).
+    pub field_opacity: f64,
+    /// Radius of the vehicles' box outlines (m).
+    pub vehicle_outline_radius_m: f64,
     /// Radius of the road lines (m).
     pub road_line_radius_m: f64,
     /// Radius of the path lines (m).
@@ -90,7 +167,7 @@ pub struct RecorderParams {
     /// Potential fields and received shared paths are recorded for the first this many
     /// vehicles (by id) only; `None`: for all. Boxes, planned paths, time series and events are
     /// recorded for every vehicle. Both grow with the number of vehicles (received paths with
-    /// its square): with 50 vehicles they made a 72 s recording 1 GB.
+    /// its square): with 50 vehicles they make a 72 s recording ~0.5 GB (1 GB in 3D).
     pub detail_vehicles: Option<usize>,
 }
 
@@ -102,18 +179,19 @@ impl Default for RecorderParams {
     fn default() -> Self {
         Self {
             blueprint: true,
-            blueprint_series: [
-                "sideslip_rad",
-                "yaw_rad",
-                "yaw_rate_radps",
-                "speed_mps",
-                "planned_speed_mps",
-            ]
-            .map(String::from)
-            .to_vec(),
+            blueprint_series: vec![
+                SeriesPlot::new("speed_mps", "Speed (m/s)", [0.0, 30.0]),
+                SeriesPlot::new("planned_speed_mps", "Planned speed (m/s)", [0.0, 30.0]),
+                SeriesPlot::new("yaw_rad", "Yaw (rad)", [-0.1, 0.1]),
+                SeriesPlot::new("yaw_rate_radps", "Yaw rate (rad/s)", [-0.2, 0.2]),
+                SeriesPlot::new("sideslip_rad", "Sideslip (rad)", [-0.02, 0.02]),
+            ],
+            follow: "ego".into(),
+            follow_window_m: FollowWindow::default(),
             field_color_scale: FieldColorScale::Log,
-            field_z_m: -0.02,
-            line_z_m: 0.03,
+            field_range: [0.0, 200.0],
+            field_opacity: 0.6,
+            vehicle_outline_radius_m: 0.15,
             road_line_radius_m: 0.08,
             path_line_radius_m: 0.06,
             detail_vehicles: Some(DEFAULT_DETAIL_VEHICLES),
@@ -222,4 +300,4 @@ fn check_finite(call: &'static str, what: &str, values: &[f64]) -> Result<(), Re
     Ok(())
 }
 
-pub use colors::{entity_part, normalize_field, vehicle_color, viridis};
+pub use colors::{entity_part, field_scale_ticks, normalize_field, vehicle_color, viridis};

@@ -4,14 +4,182 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
+use rerun::blueprint::components::{Corner2D, PanelState};
 use rerun::blueprint::{
-    Blueprint, ContainerLike, Horizontal, Spatial3DView, TextLogView, TimeSeriesView, Vertical,
+    Blueprint, BlueprintActivation, BlueprintPanel, ContainerLike, Horizontal, SelectionPanel,
+    Spatial2DView, TextLogView, TimePanel, TimeSeriesView, Vertical,
 };
 use rerun::components::{Color, TextLogLevel};
-use rerun::{RecordingStream, RecordingStreamBuilder, ViewCoordinates};
+use rerun::datatypes::{Range1D, Range2D};
+use rerun::external::re_log_types::{BlueprintActivationCommand, EntityPath};
+use rerun::external::re_sdk_types::blueprint::archetypes::{
+    PlotLegend, ScalarAxis, VisualBounds2D,
+};
+use rerun::log::LogMsg;
+use rerun::{AsComponents, RecordingStream, RecordingStreamBuilder, StoreKind};
 
 use super::colors::entity_part;
 use super::{EventLevel, Recorder, RecorderParams, RecordingError, SIM_TIMELINE, check_finite};
+
+/// A view property the blueprint builder of the 0.36 Rust SDK cannot set: logged at
+/// `view/<id>/<archetype>`, where the viewer reads it.
+struct ViewProperty {
+    view: EntityPath,
+    archetype: &'static str,
+    value: Box<dyn AsComponents>,
+}
+
+/// The blueprint store's id path of a view and the view as a container entry.
+fn view_entry(view: impl Into<ContainerLike>) -> (Option<EntityPath>, ContainerLike) {
+    let like: ContainerLike = view.into();
+    let path = match &like {
+        ContainerLike::View(v) => Some(v.blueprint_path()),
+        _ => None,
+    };
+    (path, like)
+}
+
+/// The default layout: the follow view over the whole-road view, the field's colour bar and the
+/// event log on the left; one time-series view per series on the right. Returns the blueprint
+/// and the view properties to add to it.
+fn blueprint(params: &RecorderParams) -> (Blueprint, Vec<ViewProperty>) {
+    let mut props = Vec::new();
+    let mut bounds = |view: Option<EntityPath>, x: [f64; 2], y: [f64; 2]| {
+        if let Some(view) = view {
+            props.push(ViewProperty {
+                view,
+                archetype: "VisualBounds2D",
+                value: Box::new(VisualBounds2D::new(Range2D {
+                    x_range: Range1D(x),
+                    y_range: Range1D(y),
+                })),
+            });
+        }
+    };
+    let w = params.follow_window_m;
+    let (follow_id, follow) = view_entry(
+        Spatial2DView::new(format!("Follow {} (m)", params.follow))
+            .with_origin("/world/follow")
+            .with_contents(["/world/**"]),
+    );
+    // The follow frame has Y flipped (up on screen), so the window's y range is flipped too.
+    bounds(follow_id, [-w.behind_m, w.ahead_m], [-w.side_m, w.side_m]);
+    let (road_id, road) = view_entry(
+        Spatial2DView::new("Whole road (m)")
+            .with_origin("/world/overview")
+            .with_contents(["/world/**", "- /world/paths/**"]),
+    );
+    bounds(road_id, [-10.0, 760.0], [-20.0, 12.0]);
+    let (legend_id, legend) =
+        view_entry(Spatial2DView::new("Field scale (potential U)").with_origin("/legend"));
+    bounds(
+        legend_id,
+        [-10.0, f64::from(super::entities::COLOR_BAR_STEPS) + 10.0],
+        [-12.0, 24.0],
+    );
+    let left = Vertical::new([
+        follow,
+        road,
+        legend,
+        TextLogView::new("Events").with_origin("/events").into(),
+    ])
+    .with_row_shares([3.0, 1.5, 1.2, 1.5]);
+    let mut plots: Vec<ContainerLike> = Vec::new();
+    for plot in &params.blueprint_series {
+        let (id, view) = view_entry(
+            TimeSeriesView::new(plot.title.clone())
+                .with_origin(format!("/plots/{}", entity_part(&plot.series))),
+        );
+        if let Some(id) = id {
+            if let Some(range) = plot.y_range {
+                props.push(ViewProperty {
+                    view: id.clone(),
+                    archetype: "ScalarAxis",
+                    value: Box::new(ScalarAxis::new().with_range(Range1D(range))),
+                });
+            }
+            props.push(ViewProperty {
+                view: id,
+                archetype: "PlotLegend",
+                value: Box::new(PlotLegend::new().with_corner(Corner2D::RightBottom)),
+            });
+        }
+        plots.push(view);
+    }
+    let root = if plots.is_empty() {
+        Horizontal::new([left.into()])
+    } else {
+        Horizontal::new([left.into(), Vertical::new(plots).into()]).with_column_shares([3.0, 2.0])
+    };
+    // The side panels start collapsed (the views get the room) and the time panel as its
+    // compact bar on `sim_time`; every panel opens with one click.
+    let bp = Blueprint::new(root)
+        .with_auto_views(false)
+        .with_auto_layout(false)
+        .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
+        .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
+        .with_time_panel(
+            TimePanel::new()
+                .with_state(PanelState::Collapsed)
+                .with_timeline(SIM_TIMELINE),
+        );
+    (bp, props)
+}
+
+/// The blueprint's messages (the SDK's own, plus the view properties it cannot write) and the
+/// command that makes it the default layout.
+fn blueprint_messages(
+    app_id: &rerun::ApplicationId,
+    params: &RecorderParams,
+) -> Result<(Vec<LogMsg>, BlueprintActivationCommand), RecordingError> {
+    let (bp, props) = blueprint(params);
+    // Let the SDK write its messages into memory.
+    let (mem, storage) = RecordingStreamBuilder::new(app_id.clone())
+        .enabled(true)
+        .memory()?;
+    bp.send(
+        &mem,
+        BlueprintActivation {
+            make_active: false,
+            make_default: true,
+        },
+    )?;
+    let mut msgs = Vec::new();
+    let mut activation = None;
+    for msg in storage.take() {
+        match msg {
+            LogMsg::BlueprintActivationCommand(cmd) => activation = Some(cmd),
+            msg if msg.store_id().kind() == StoreKind::Blueprint => msgs.push(msg),
+            _ => {}
+        }
+    }
+    let Some(activation) = activation else {
+        return Err(RecordingError::InvalidInput {
+            call: "blueprint",
+            reason: "the SDK wrote no blueprint activation".into(),
+        });
+    };
+    // The view properties, into the same blueprint store.
+    let (extra, extra_storage) = RecordingStreamBuilder::new(app_id.clone())
+        .enabled(true)
+        .recording_id(activation.blueprint_id.recording_id().clone())
+        .blueprint()
+        .memory()?;
+    extra.set_time_sequence("blueprint", 0);
+    for p in &props {
+        extra.log(
+            p.view.join(&EntityPath::from_single_string(p.archetype)),
+            p.value.as_ref(),
+        )?;
+    }
+    msgs.extend(
+        extra_storage
+            .take()
+            .into_iter()
+            .filter(|m| matches!(m, LogMsg::ArrowMsg(..))),
+    );
+    Ok((msgs, activation))
+}
 
 /// An open recording: the stream writing `<path>.tmp`, renamed to `<path>` by
 /// [`Recorder::finish`].
@@ -44,18 +212,22 @@ impl Recorder {
                 call: "new_file",
                 reason: e.to_string(),
             })?;
-        let mut builder = RecordingStreamBuilder::new(app_id).enabled(true);
-        if params.blueprint {
-            builder = builder.with_default_blueprint(Self::blueprint(&params));
-        }
+        let blueprint = if params.blueprint {
+            Some(blueprint_messages(&app_id, &params)?)
+        } else {
+            None
+        };
+        let builder = RecordingStreamBuilder::new(app_id).enabled(true);
         // A stale temporary file (or link) of a killed process is removed, never written
         // through.
         if std::fs::symlink_metadata(&tmp_path).is_ok() {
             std::fs::remove_file(&tmp_path).ok();
         }
         let stream = builder.save(&tmp_path)?;
-        stream.log_static("world", &ViewCoordinates::RIGHT_HAND_Z_UP())?;
-        Ok(Self {
+        if let Some((msgs, activation)) = blueprint {
+            stream.send_blueprint(msgs, activation);
+        }
+        let recorder = Self {
             params,
             active: Some(ActiveRecording {
                 stream,
@@ -64,34 +236,9 @@ impl Recorder {
                 styled_series: BTreeSet::new(),
                 name_colors: BTreeMap::new(),
             }),
-        })
-    }
-
-    /// The default layout: road 3D view over the event log, time series on the right.
-    fn blueprint(params: &RecorderParams) -> Blueprint {
-        let plots: Vec<ContainerLike> = params
-            .blueprint_series
-            .iter()
-            .map(|series| {
-                TimeSeriesView::new(series.clone())
-                    .with_origin(format!("/plots/{}", entity_part(series)))
-                    .into()
-            })
-            .collect();
-        let left = Vertical::new([
-            Spatial3DView::new("Road").with_origin("/world").into(),
-            TextLogView::new("Events").with_origin("/events").into(),
-        ])
-        .with_row_shares([3.0, 1.0]);
-        let root = if plots.is_empty() {
-            Horizontal::new([left.into()])
-        } else {
-            Horizontal::new([left.into(), Vertical::new(plots).into()])
-                .with_column_shares([3.0, 2.0])
         };
-        Blueprint::new(root)
-            .with_auto_views(false)
-            .with_auto_layout(false)
+        recorder.log_field_legend()?;
+        Ok(recorder)
     }
 
     /// Sets the current time of the `sim_time` timeline (s).
@@ -152,6 +299,16 @@ impl Drop for Recorder {
 }
 
 impl EventLevel {
+    /// Lower-case name (an entity-path part).
+    pub(super) fn name(self) -> &'static str {
+        match self {
+            Self::Debug => "debug",
+            Self::Info => "info",
+            Self::Warn => "warn",
+            Self::Error => "error",
+        }
+    }
+
     pub(super) fn as_text_log_level(self) -> TextLogLevel {
         TextLogLevel::from(match self {
             Self::Debug => TextLogLevel::DEBUG,

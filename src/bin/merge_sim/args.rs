@@ -82,6 +82,21 @@ pub(crate) struct RunArgs {
     /// Open the recording in the Rerun viewer afterwards (needs `rerun` on PATH).
     #[arg(long, conflicts_with = "no_rrd")]
     pub(crate) view: bool,
+    /// The vehicle the recording's follow view (and --gif) keeps in view [default: `ego`, or
+    /// the scenario's first vehicle if none is called so]; an unknown name is refused before
+    /// the run.
+    #[arg(long, value_name = "NAME")]
+    pub(crate) follow: Option<String>,
+    /// Write a top-down animated GIF of the run here (drawn on the CPU: no GPU or display),
+    /// following --follow.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) gif: Option<PathBuf>,
+    /// Frames per second of the GIF, of simulated time and of playback (real time).
+    #[arg(long, value_name = "FPS", default_value_t = 10.0, requires = "gif")]
+    pub(crate) gif_fps: f64,
+    /// Width of the GIF (pixels); the height follows from the road's width.
+    #[arg(long, value_name = "PX", default_value_t = 800, requires = "gif")]
+    pub(crate) gif_width: u32,
     /// Write the JSON summary here.
     #[arg(long, value_name = "PATH")]
     pub(crate) json: Option<PathBuf>,

@@ -86,9 +86,19 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
             (rrd.as_deref(), "--rrd"),
             (args.json.as_deref(), "--json"),
             (args.csv.as_deref(), "--csv"),
+            (args.gif.as_deref(), "--gif"),
         ],
         &scenario_file(&args.source.scenario),
     )?;
+    let follow = followed_vehicle(&scenario, args.follow.as_deref())?;
+    let gif_params = mergesim::animation::GifParams {
+        fps: args.gif_fps,
+        width_px: args.gif_width,
+        ..mergesim::animation::GifParams::default()
+    };
+    if args.gif.is_some() {
+        gif_params.validate().map_err(input)?;
+    }
     if let Some(path) = &rrd {
         let instance = scenario.instance(args.seed);
         let bytes = sim::recording::size_estimate::estimated_bytes(
@@ -113,12 +123,22 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
         planner: args.planner,
         seed: args.seed,
         rrd: rrd.as_deref(),
-        keep_time_series: args.csv.is_some(),
+        keep_time_series: args.csv.is_some() || args.gif.is_some(),
         show_progress,
         profile: args.profile,
         record_detail: args.record_detail.0,
+        follow: Some(&follow),
     };
     let finished = simulate(&scenario, &what, interrupt)?;
+    if let Some(path) = &args.gif {
+        let gif = GifRun {
+            path,
+            follow: &follow,
+            params: &gif_params,
+            show_progress,
+        };
+        write_run_gif(&gif, &scenario, args, &finished)?;
+    }
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&finished.summary).map_err(run_failure)?;
         write_atomically(path, text.as_bytes())
@@ -161,6 +181,96 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
     Ok(())
 }
 
+/// The vehicle `--follow` names (it must exist: exit 2 before any work), else `ego`, else the
+/// scenario's first vehicle.
+fn followed_vehicle(scenario: &Scenario, asked: Option<&str>) -> Result<String, Failure> {
+    let names: Vec<&str> = scenario.vehicles.iter().map(|v| v.name.as_str()).collect();
+    match asked {
+        Some(name) if names.contains(&name) => Ok(name.to_string()),
+        Some(name) => Err(input(anyhow!(
+            "--follow: no vehicle named {name:?} in {} (vehicles: {})",
+            scenario.name,
+            names.join(", ")
+        ))),
+        None if names.contains(&"ego") => Ok("ego".into()),
+        None => Ok(names
+            .first()
+            .map_or_else(|| "ego".into(), |n| n.to_string())),
+    }
+}
+
+/// Where and how `--gif` is written.
+struct GifRun<'a> {
+    path: &'a Path,
+    follow: &'a str,
+    params: &'a mergesim::animation::GifParams,
+    show_progress: bool,
+}
+
+/// Writes `--gif` from the run's time series and prints where it went.
+fn write_run_gif(
+    gif: &GifRun<'_>,
+    scenario: &Scenario,
+    args: &RunArgs,
+    finished: &mergesim::experiment::Finished,
+) -> Result<(), Failure> {
+    let GifRun {
+        path,
+        follow,
+        params,
+        show_progress,
+    } = *gif;
+    use mergesim::animation::{GifVehicle, write_gif};
+    let instance = scenario.instance(args.seed);
+    let mut vehicles = Vec::with_capacity(instance.vehicles.len());
+    for (id, spec) in instance.vehicles.iter().enumerate() {
+        let car = vehicles::VehicleParams::preset(&spec.preset).map_err(input)?;
+        vehicles.push(GifVehicle {
+            name: spec.name.clone(),
+            id: u32::try_from(id).map_err(input)?,
+            length_m: car.length_m,
+            width_m: car.width_m,
+        });
+    }
+    let title = format!("{} {}", finished.summary.scenario, finished.summary.planner);
+    let started = std::time::Instant::now();
+    let mut last_percent = -1i64;
+    let progress = |fraction: f64| {
+        let percent = (fraction * 100.0).floor() as i64;
+        if show_progress && percent != last_percent {
+            last_percent = percent;
+            eprint!("\rgif: {percent:3}%");
+            if percent >= 100 {
+                eprintln!();
+            }
+        }
+    };
+    let stats = write_gif(
+        path,
+        &instance.sim.road,
+        &vehicles,
+        &finished.outcome.time_series,
+        &finished.outcome.safety.collisions,
+        follow,
+        &title,
+        params,
+        progress,
+    )
+    .map_err(run_failure)?;
+    if !args.quiet {
+        outln!(
+            "gif: {} ({} frames, {} x {} px, {:.2} MB, written in {:.1} s)",
+            path.display(),
+            stats.frames,
+            stats.size_px.0,
+            stats.size_px.1,
+            stats.bytes as f64 / 1e6,
+            started.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}
+
 pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(), Failure> {
     let scenario = load_scenario(&args.source.scenario, args.source.params)?;
     check_outputs(
@@ -174,6 +284,7 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
     let show_progress = std::io::stderr().is_terminal();
     let mut summaries = Vec::new();
     let mut time_series = Vec::new();
+    let mut collisions = Vec::new();
     for &kind in &args.planners {
         let what = Simulation {
             planner: Some(kind),
@@ -185,6 +296,7 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
         let finished = simulate(&scenario, &what, interrupt)?;
         summaries.push(finished.summary);
         time_series.push(finished.outcome.time_series);
+        collisions.push(finished.outcome.safety.collisions);
     }
     out!("{}", comparison_table(&summaries));
     if let Some(path) = &args.json {
@@ -197,9 +309,11 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
         let series: Vec<mergesim::plots::PlannerSeries<'_>> = summaries
             .iter()
             .zip(&time_series)
-            .map(|(s, rows)| mergesim::plots::PlannerSeries {
+            .zip(&collisions)
+            .map(|((s, rows), collisions)| mergesim::plots::PlannerSeries {
                 planner: &s.planner,
                 rows,
+                collisions,
             })
             .collect();
         let road = &scenario.instance(args.seed).sim.road;

@@ -151,6 +151,8 @@ pub(crate) struct Simulation<'a> {
     pub(crate) profile: bool,
     /// Vehicles with fields and received paths in the recording (None: all).
     pub(crate) record_detail: Option<usize>,
+    /// The vehicle the recording's follow view follows (None: the default, `ego`).
+    pub(crate) follow: Option<&'a str>,
 }
 
 /// Runs one instance of `scenario` (the library's `run_instance`), with a progress line on a
@@ -168,6 +170,7 @@ pub(crate) fn simulate(
         show_progress,
         profile,
         record_detail,
+        follow,
     } = *what;
     let planner = planner.map(|k| k.name().to_string());
     let label = planner_label(scenario, planner.as_deref());
@@ -177,6 +180,7 @@ pub(crate) fn simulate(
             "mergesim",
             RecorderParams {
                 detail_vehicles: record_detail,
+                follow: follow.map_or_else(|| RecorderParams::default().follow, str::to_string),
                 ..RecorderParams::default()
             },
         )

@@ -1,0 +1,112 @@
+//! `merge_sim run --gif` and `--follow` as a user runs them: the animation's frames and size,
+//! the vehicles in it, and bad input refused with exit code 2 before any work.
+
+mod common;
+
+use std::path::Path;
+
+use common::{merge_sim, scratch, stderr};
+
+/// Frames, width, height and delays (centiseconds) of a GIF; the first frame as RGBA.
+fn decode_gif(path: &Path) -> (usize, u16, u16, Vec<u16>, Vec<u8>) {
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let file = std::fs::File::open(path).unwrap();
+    let mut decoder = options.read_info(file).unwrap();
+    let (w, h) = (decoder.width(), decoder.height());
+    let mut frames = 0;
+    let mut delays = Vec::new();
+    let mut first = Vec::new();
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        if frames == 0 {
+            first = frame.buffer.to_vec();
+        }
+        frames += 1;
+        delays.push(frame.delay);
+    }
+    (frames, w, h, delays, first)
+}
+
+#[test]
+fn gif_has_one_frame_per_tenth_of_a_second_and_shows_the_vehicles() {
+    let dir = scratch("gif_default");
+    let gif = dir.join("urgent.gif");
+    let out = merge_sim(&["run", "--no-rrd", "--gif", gif.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("gif: ") && stdout.contains("250 frames"),
+        "{stdout}"
+    );
+    let (frames, w, h, delays, first) = decode_gif(&gif);
+    // 25 s logged at 20 Hz from t = 0.05 s, one frame per 0.1 s.
+    assert_eq!(frames, 250);
+    assert_eq!(w, 800);
+    // 22 px header + (7 m road + 2 × 2 m margins) × 10 px/m.
+    assert_eq!(h, 132);
+    assert!(delays.iter().all(|&d| d == 10), "{delays:?}");
+    // The ego's green and the obstacle's blue (the recording's palette) are in the first frame.
+    let has = |rgb: [u8; 3]| first.chunks(4).any(|p| p[..3] == rgb);
+    assert!(has([44, 160, 44]), "no ego in the first frame");
+    assert!(has([31, 119, 180]), "no obstacle in the first frame");
+    // Nothing else left in the folder (the temporary file was renamed).
+    let names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, ["urgent.gif"]);
+}
+
+#[test]
+fn gif_options_change_rate_and_size() {
+    let dir = scratch("gif_options");
+    let gif = dir.join("small.gif");
+    let out = merge_sim(&[
+        "run",
+        "--no-rrd",
+        "--quiet",
+        "--follow",
+        "obstacle",
+        "--gif",
+        gif.to_str().unwrap(),
+        "--gif-fps",
+        "5",
+        "--gif-width",
+        "400",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(out.stdout.is_empty(), "--quiet prints nothing");
+    let (frames, w, _, delays, _) = decode_gif(&gif);
+    assert_eq!(frames, 125);
+    assert_eq!(w, 400);
+    assert!(delays.iter().all(|&d| d == 20));
+}
+
+#[test]
+fn bad_follow_and_gif_options_are_refused_before_the_run() {
+    let dir = scratch("gif_bad");
+    let gif = dir.join("x.gif");
+    let cases: [(&[&str], &str); 4] = [
+        (&["--follow", "nobody"], "--follow"),
+        (&["--gif-fps", "0"], "fps"),
+        (&["--gif-width", "20"], "width"),
+        (&["--gif", "/nonexistent/dir/x.gif"], "does not exist"),
+    ];
+    for (extra, needle) in cases {
+        let mut args = vec!["run", "--no-rrd"];
+        if !extra.contains(&"--gif") {
+            args.extend(["--gif", gif.to_str().unwrap()]);
+        }
+        args.extend_from_slice(extra);
+        let started = std::time::Instant::now();
+        let out = merge_sim(&args);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{extra:?}: {}", stderr(&out));
+        assert!(!gif.exists(), "{extra:?} wrote the gif");
+        // Refused before the simulation (which takes ~0.3 s) and the drawing (~3 s).
+        assert!(started.elapsed().as_secs_f64() < 2.0, "{extra:?} was slow");
+    }
+    // --gif-fps without --gif is a usage error too.
+    let out = merge_sim(&["run", "--no-rrd", "--gif-fps", "5"]);
+    assert_eq!(out.status.code(), Some(2));
+}
