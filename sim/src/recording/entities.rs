@@ -26,6 +26,30 @@ const DRAW_VEHICLES: f32 = 20.0;
 /// Width of the colour bar (pixels of its image; one per step of the scale).
 pub(super) const COLOR_BAR_STEPS: u32 = 256;
 
+/// Length (m, in the whole-road view's frame) that any road is scaled to fit: the view's fixed
+/// bounds show [−10, `OVERVIEW_LENGTH_M` + 10] × [−`OVERVIEW_HALF_HEIGHT_M`, +…].
+pub(super) const OVERVIEW_LENGTH_M: f64 = 750.0;
+/// Half height (m) of the whole-road view's fixed bounds.
+pub(super) const OVERVIEW_HALF_HEIGHT_M: f64 = 16.0;
+
+/// The whole-road view's frame `world/overview` for `road`: its origin at the road's start
+/// (X) and centre line (Y), Y flipped (up on screen), and scaled so that a road longer than
+/// [`OVERVIEW_LENGTH_M`] fits the view's fixed bounds (a shorter one keeps 1 m = 1 m). Returns
+/// (translation, scale): a world point p appears in the view at scale · R⁻¹ (p − translation).
+pub(super) fn overview_frame(road: &MergeRoad) -> ([f32; 3], f32) {
+    let length_m = road.end_x_m - road.start_x_m;
+    let scale = if length_m.is_finite() && length_m > OVERVIEW_LENGTH_M {
+        OVERVIEW_LENGTH_M / length_m
+    } else {
+        1.0
+    };
+    let centre_y_m = 0.5 * (road.y_bottom_m + road.y_upper_m());
+    (
+        [road.start_x_m as f32, centre_y_m as f32, 0.0],
+        scale as f32,
+    )
+}
+
 /// Colour of event markers by level.
 fn event_color(level: EventLevel) -> Color {
     match level {
@@ -82,9 +106,15 @@ impl Recorder {
             .with_colors([Color::from_unmultiplied_rgba(255, 140, 0, 50)])
             .with_draw_order(DRAW_MERGE_SECTION),
         )?;
+        // The frame's scale is the inverse of the view's: world lengths shrink by `scale`.
+        let (translation, scale) = overview_frame(road);
         active.stream.log_static(
             "world/overview",
-            &Transform3D::from_rotation(y_up_quaternion()),
+            &Transform3D::from_translation_rotation_scale(
+                translation,
+                y_up_quaternion(),
+                1.0 / scale,
+            ),
         )?;
         Ok(())
     }
@@ -419,5 +449,57 @@ impl Recorder {
             active.stream.log(path, &Scalars::single(y_min))?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Where a world point appears in the whole-road view: scale · R⁻¹ (p − translation), R the
+    /// Y flip.
+    fn in_view(road: &MergeRoad, x_m: f64, y_m: f64) -> (f64, f64) {
+        let ([tx, ty, _], scale) = overview_frame(road);
+        let s = f64::from(scale);
+        (s * (x_m - f64::from(tx)), -s * (y_m - f64::from(ty)))
+    }
+
+    #[test]
+    fn the_whole_road_view_shows_every_road_whole() {
+        let urgent = MergeRoad::default();
+        let platoon = MergeRoad {
+            merge_start_x_m: 1300.0,
+            merge_end_x_m: 1400.0,
+            end_x_m: 3000.0,
+            ..MergeRoad::default()
+        };
+        let short = MergeRoad {
+            merge_start_x_m: 20.0,
+            merge_end_x_m: 60.0,
+            start_x_m: 0.0,
+            end_x_m: 100.0,
+            ..MergeRoad::default()
+        };
+        // A road up to 750 m long keeps 1 m = 1 m; a longer one is scaled down.
+        assert_eq!(overview_frame(&urgent).1, 1.0);
+        assert_eq!(overview_frame(&short).1, 1.0);
+        assert!((f64::from(overview_frame(&platoon).1) - 750.0 / 3050.0).abs() < 1e-6);
+        for road in [urgent, platoon, short] {
+            for x_m in [
+                road.start_x_m,
+                road.merge_start_x_m,
+                road.merge_end_x_m,
+                road.end_x_m,
+            ] {
+                for y_m in [road.y_bottom_m, road.y_upper_m()] {
+                    let (x, y) = in_view(&road, x_m, y_m);
+                    assert!(
+                        (-10.0..=OVERVIEW_LENGTH_M + 10.0).contains(&x)
+                            && (-OVERVIEW_HALF_HEIGHT_M..=OVERVIEW_HALF_HEIGHT_M).contains(&y),
+                        "{road:?}: ({x_m}, {y_m}) appears at ({x}, {y})"
+                    );
+                }
+            }
+        }
     }
 }

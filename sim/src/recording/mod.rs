@@ -23,7 +23,7 @@
 //! | `world/paths/<name>/received` | `LineStrips2D` | shared local paths received over V2V |
 //! | `world/fields/<name>` | `Image` (RGBA) + `Transform3D` | a potential field on the fixed colour scale, under the rest |
 //! | `world/follow` | `Transform3D` | a frame at the followed vehicle, Y flipped: the follow view's origin |
-//! | `world/overview` | `Transform3D` (static) | the road frame, Y flipped: the whole-road view's origin |
+//! | `world/overview` | `Transform3D` (static) | the road frame (origin at the road's start and centre line, Y flipped, roads longer than 750 m scaled down to 750 m): the whole-road view's origin, so its fixed bounds show the whole of any road |
 //! | `legend/field_scale` | `Image`, `Points2D` (static) | the field's colour bar and its labelled ticks |
 //! | `plots/<series>/<name>` | `Scalars` (+ static `SeriesLines`) | one plot per series |
 //! | `plots/<series>/events/<level>` | `Scalars` (+ static `SeriesPoints`) | a marker per event (info, warn, error), at the plot's lower y bound |

@@ -69,7 +69,13 @@ fn blueprint(params: &RecorderParams) -> (Blueprint, Vec<ViewProperty>) {
             .with_origin("/world/overview")
             .with_contents(["/world/**", "- /world/paths/**"]),
     );
-    bounds(road_id, [-10.0, 760.0], [-20.0, 12.0]);
+    // The road's own frame is scaled to fit these bounds (`entities::overview_frame`).
+    let half_height_m = super::entities::OVERVIEW_HALF_HEIGHT_M;
+    bounds(
+        road_id,
+        [-10.0, super::entities::OVERVIEW_LENGTH_M + 10.0],
+        [-half_height_m, half_height_m],
+    );
     let (legend_id, legend) =
         view_entry(Spatial2DView::new("Field scale (potential U)").with_origin("/legend"));
     bounds(
