@@ -1,7 +1,7 @@
 //! Merging the shards of one sweep into the aggregate of the whole (`merge_sim merge-results`).
 
 use super::paired::check_paired;
-use super::rows::JsonlLine;
+use super::summary::jsonl_line_with;
 use super::{
     PairedSweepSummary, Shard, SweepError, SweepIdentity, SweepReport, SweepSummary, instance_seed,
 };
@@ -24,17 +24,7 @@ pub fn merged_jsonl(report: &SweepReport) -> Result<String, SweepError> {
     };
     let mut text = String::new();
     for row in report.rows() {
-        let line = serde_json::to_string(&JsonlLine {
-            scenario: &identity.scenario,
-            scenario_fingerprint: &identity.scenario_fingerprint,
-            params: &identity.params,
-            planners: &identity.planners,
-            sweep_seed: identity.seed,
-            total_runs: identity.total_runs,
-            row,
-            wall_time_s: None,
-        })
-        .map_err(|e| {
+        let line = jsonl_line_with(&identity, row, None).map_err(|e| {
             SweepError::Invalid(format!(
                 "instance {} ({}): cannot write its row: {e}",
                 row.instance, row.planner

@@ -84,6 +84,15 @@ pub fn jsonl_line(
     row: &RunRow,
     wall_time_s: f64,
 ) -> Result<String, serde_json::Error> {
+    jsonl_line_with(identity, row, Some(wall_time_s))
+}
+
+/// [`jsonl_line`] with the run's wall time optional (null: unknown, as in merged shards).
+pub(super) fn jsonl_line_with(
+    identity: &SweepIdentity,
+    row: &RunRow,
+    wall_time_s: Option<f64>,
+) -> Result<String, serde_json::Error> {
     serde_json::to_string(&JsonlLine {
         scenario: &identity.scenario,
         scenario_fingerprint: &identity.scenario_fingerprint,
@@ -92,7 +101,7 @@ pub fn jsonl_line(
         sweep_seed: identity.seed,
         total_runs: identity.total_runs,
         row,
-        wall_time_s: Some(wall_time_s),
+        wall_time_s,
     })
 }
 

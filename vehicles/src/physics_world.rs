@@ -109,15 +109,10 @@ impl PhysicsWorld {
 
     fn insert_flat_ground(&mut self, half_extent_m: f64) -> ColliderHandle {
         let half_z = 0.5 * FLAT_GROUND_THICKNESS_M;
-        let collider =
+        self.add_road_surface(
             ColliderBuilder::cuboid(half_extent_m as Real, half_extent_m as Real, half_z as Real)
-                .translation(Vector::new(0.0, 0.0, -half_z as Real))
-                .collision_groups(collision_groups::road_surface())
-                .build();
-        let handle = self.world.insert_collider(collider, None);
-        self.road_surfaces.push(handle);
-        self.refresh_queries();
-        handle
+                .translation(Vector::new(0.0, 0.0, -half_z as Real)),
+        )
     }
 
     /// Adds the merge road: surface plus edge barriers along the upper edge and along each
