@@ -319,6 +319,10 @@ fn draw_frame(
         }
         let corners = footprint(row.x_m, row.y_m, row.yaw_rad, v.length_m, v.width_m)
             .map(|(x, y)| to_px(x, y));
+        // Outside the window: not drawn (its label would be pinned to the picture's edge).
+        if corners.iter().all(|&(x, _)| x < 0) || corners.iter().all(|&(x, _)| x >= w as i32) {
+            continue;
+        }
         let [r, g, b] = vehicle_color(v.id);
         root.draw(&Polygon::new(corners.to_vec(), RGBColor(r, g, b).filled()))
             .map_err(|x| e(&x))?;
@@ -396,6 +400,78 @@ mod tests {
         assert_eq!(all.len(), 41);
         // 2 s at 10 fps: 21 frames (0, 0.1, ..., 2.0).
         assert_eq!(frame_instants(&all, 10.0).len(), 21);
+    }
+
+    fn row(vehicle: &str, x_m: f64, y_m: f64) -> TimeSeriesRow {
+        TimeSeriesRow {
+            t_s: 1.0,
+            vehicle: vehicle.into(),
+            x_m,
+            y_m,
+            yaw_rad: 0.0,
+            yaw_rate_radps: 0.0,
+            sideslip_rad: 0.0,
+            speed_mps: 20.0,
+            planned_speed_mps: 20.0,
+            accel_long_mps2: 0.0,
+            accel_lat_mps2: 0.0,
+        }
+    }
+
+    /// One frame drawn into memory.
+    fn frame(instant: &[TimeSeriesRow]) -> Vec<u8> {
+        let road = sim::MergeRoad::default();
+        let params = GifParams::default();
+        let size = params.size_px(road.y_upper_m() - road.y_bottom_m);
+        let vehicles: Vec<GifVehicle> = ["ego", "far"]
+            .iter()
+            .zip(0..)
+            .map(|(name, id)| GifVehicle {
+                name: (*name).into(),
+                id,
+                length_m: 4.5,
+                width_m: 1.8,
+            })
+            .collect();
+        let mut buffer = vec![0u8; (size.0 * size.1 * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
+            draw_frame(
+                &root,
+                &road,
+                &vehicles,
+                instant,
+                &[],
+                "ego",
+                "test",
+                &params,
+                size,
+            )
+            .unwrap_or_else(|e| panic!("{e}"));
+            root.present().unwrap_or_else(|e| panic!("{e}"));
+        }
+        buffer
+    }
+
+    #[test]
+    fn vehicles_outside_the_window_leave_the_frame_untouched() {
+        ensure_font().unwrap_or_else(|e| panic!("{e}"));
+        let alone = frame(&[row("ego", 100.0, 1.75)]);
+        // 100 m behind and 200 m ahead of a window of 30 m behind to 50 m ahead: not drawn,
+        // not even their labels at the edge.
+        assert_eq!(
+            frame(&[row("ego", 100.0, 1.75), row("far", 0.0, 5.25)]),
+            alone
+        );
+        assert_eq!(
+            frame(&[row("ego", 100.0, 1.75), row("far", 300.0, 5.25)]),
+            alone
+        );
+        // 20 m ahead: drawn.
+        assert_ne!(
+            frame(&[row("ego", 100.0, 1.75), row("far", 120.0, 5.25)]),
+            alone
+        );
     }
 
     #[test]
