@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod animation;
+pub mod build_info;
 pub mod exact_seed;
 pub mod experiment;
 pub mod grid;
