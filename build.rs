@@ -31,17 +31,17 @@ fn main() {
     if let Some(git_dir) = git(&["rev-parse", "--git-dir"]) {
         let head = Path::new(&git_dir).join("HEAD");
         println!("cargo:rerun-if-changed={}", head.display());
-        if let Some(reference) = git(&["symbolic-ref", "-q", "HEAD"]) {
-            if let Some(common) = git(&["rev-parse", "--git-common-dir"]) {
-                println!(
-                    "cargo:rerun-if-changed={}",
-                    Path::new(&common).join(&reference).display()
-                );
-                println!(
-                    "cargo:rerun-if-changed={}",
-                    Path::new(&common).join("packed-refs").display()
-                );
-            }
+        if let Some(reference) = git(&["symbolic-ref", "-q", "HEAD"])
+            && let Some(common) = git(&["rev-parse", "--git-common-dir"])
+        {
+            println!(
+                "cargo:rerun-if-changed={}",
+                Path::new(&common).join(&reference).display()
+            );
+            println!(
+                "cargo:rerun-if-changed={}",
+                Path::new(&common).join("packed-refs").display()
+            );
         }
     }
     println!("cargo:rerun-if-changed=build.rs");
