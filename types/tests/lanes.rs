@@ -1,0 +1,698 @@
+//! Roads made of lanes: the frame (round trips, heading, curvature), cleaning, the drivable
+//! area, the merge road through lanes, refusal of inconsistent data, invariance and precision.
+
+use std::f64::consts::PI;
+
+use mergesim_types::lanes::{
+    Centreline, ENDING_LANE_ID, LaneError, LaneId, LaneKind, LaneRoad, LaneRoadSpec, LaneSpec,
+    LaneTolerances, OnRampParams, THROUGH_LANE_ID, curved_merge_spec, on_ramp_ids, on_ramp_spec,
+};
+use mergesim_types::{Lane as MergeLane, MergeRoad};
+
+const R: f64 = 300.0;
+
+fn curved() -> LaneRoad {
+    LaneRoad::new(&curved_merge_spec(&MergeRoad::default(), R)).unwrap()
+}
+
+/// Points of a circular arc about `c`, radius `r`, from angle `a0` over `sweep` (rad), chords of
+/// at most `step` (m).
+fn arc(c: [f64; 2], r: f64, a0: f64, sweep: f64, step: f64) -> Vec<[f64; 2]> {
+    let n = ((r * sweep.abs()) / step).ceil() as usize;
+    (0..=n)
+        .map(|k| {
+            let a = a0 + sweep * k as f64 / n as f64;
+            [c[0] + r * a.cos(), c[1] + r * a.sin()]
+        })
+        .collect()
+}
+
+fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+#[test]
+fn projection_round_trips_on_curved_lanes() {
+    let road = curved();
+    let mut worst_sd: f64 = 0.0;
+    let mut worst_p: f64 = 0.0;
+    for id in [THROUGH_LANE_ID, ENDING_LANE_ID] {
+        let lane = road.lane(id).unwrap();
+        let len = lane.length_m();
+        for i in 0..=400 {
+            // s from 10 m before the start to 10 m after the end, off the vertices.
+            let s = -10.0 + (len + 20.0) * (i as f64 + 0.37) / 401.0;
+            for d in [-3.5, -1.75, -0.3, 0.0, 0.9, 1.75, 3.5] {
+                let p = lane.point(s, d);
+                let fp = lane.project(p);
+                worst_sd = worst_sd.max((fp.s_m - s).abs()).max((fp.d_m - d).abs());
+                // And point → (s, d) → point.
+                let q = [p[0] + 0.123 * d, p[1] - 0.077 * s / len];
+                let back = lane.point(lane.project(q).s_m, lane.project(q).d_m);
+                worst_p = worst_p.max(dist(back, q));
+            }
+        }
+    }
+    // Scale: coordinates up to ~600 m; 1e-9 · 1 m is far below that.
+    assert!(worst_sd < 1e-9, "(s, d) round trip error {worst_sd:e} m");
+    assert!(worst_p < 1e-9, "point round trip error {worst_p:e} m");
+}
+
+#[test]
+fn arc_heading_and_curvature_match_the_circle() {
+    let road = curved();
+    let centre = [0.0, MergeRoad::default().y_lane_m() + R];
+    let w = MergeRoad::default().lane_width_m;
+    for (id, radius) in [
+        (THROUGH_LANE_ID, R - 0.5 * w),
+        (ENDING_LANE_ID, R + 0.5 * w),
+    ] {
+        let lane = road.lane(id).unwrap();
+        let mut worst_k: f64 = 0.0;
+        let mut worst_h: f64 = 0.0;
+        for i in 0..2000 {
+            let s = lane.length_m() * (i as f64 + 0.5) / 2000.0;
+            let (h, k) = lane.centreline().heading_and_curvature(s);
+            worst_k = worst_k.max((k * radius - 1.0).abs());
+            // The circle's tangent at the point's angle about the centre (left turn: +π/2).
+            let p = lane.point(s, 0.0);
+            let tangent = (p[1] - centre[1]).atan2(p[0] - centre[0]) + 0.5 * PI;
+            let dh = ((h - tangent + PI).rem_euclid(2.0 * PI) - PI).abs();
+            worst_h = worst_h.max(dh);
+        }
+        // Stated bound (module docs): relative c²/(4R²) = 2.8e-6 for c = 1 m, R ≈ 300 m.
+        assert!(
+            worst_k < 1e-5,
+            "lane {id}: relative curvature error {worst_k:e}"
+        );
+        assert!(worst_h < 1e-6, "lane {id}: heading error {worst_h:e} rad");
+    }
+}
+
+#[test]
+fn frame_axes_match_finite_differences() {
+    let road = curved();
+    let lane = road.lane(THROUGH_LANE_ID).unwrap();
+    let h = 1e-5;
+    for (s, d) in [(10.3, 1.2), (250.55, -2.0), (600.01, 0.4)] {
+        let ax = lane.centreline().axes(s, d);
+        let ps = [lane.point(s + h, d), lane.point(s - h, d)];
+        let pd = [lane.point(s, d + h), lane.point(s, d - h)];
+        for i in 0..2 {
+            assert!((ax.dp_ds[i] - (ps[0][i] - ps[1][i]) / (2.0 * h)).abs() < 1e-6);
+            assert!((ax.dp_dd[i] - (pd[0][i] - pd[1][i]) / (2.0 * h)).abs() < 1e-6);
+        }
+    }
+}
+
+#[test]
+fn duplicate_vertex_centreline_is_cleaned_without_jumps() {
+    let radius = 150.0;
+    let clean = arc([0.0, radius], radius, -0.5 * PI, 0.6, 1.0);
+    let mut raw = Vec::new();
+    for (i, p) in clean.iter().enumerate() {
+        raw.push(*p);
+        if i % 7 == 3 {
+            raw.push(*p); // exact duplicate
+        }
+        if i % 11 == 5 && i + 1 < clean.len() {
+            raw.push([p[0] + 1e-3, p[1] + 5e-4]); // near-duplicate (1.1 mm)
+        }
+    }
+    assert!(raw.len() > clean.len() + 10);
+    let c = Centreline::new(
+        LaneId(1),
+        &raw,
+        LaneTolerances::default().vertex_merge_m,
+        0.0,
+    )
+    .unwrap();
+    assert_eq!(c.vertex_count(), clean.len());
+    // Without cleaning (tolerance 0: only exact duplicates go), the near-duplicates remain and
+    // the curvature spikes at them.
+    let noisy = Centreline::new(LaneId(1), &raw, 0.0, 0.0).unwrap();
+    assert!(noisy.vertex_count() > clean.len());
+    let spike = noisy
+        .vertex_s_m()
+        .iter()
+        .map(|&s| noisy.curvature_1pm(s).abs())
+        .fold(0.0, f64::max);
+    assert!(spike * radius > 10.0, "raw curvature spike {spike}");
+    // Cleaned: heading and curvature continuous at every vertex, curvature = 1/R.
+    let eps = 1e-7;
+    for &s in &c.vertex_s_m()[1..c.vertex_count() - 1] {
+        let jump_h = (c.heading_rad(s + eps) - c.heading_rad(s - eps)).abs();
+        let jump_k = (c.curvature_1pm(s + eps) - c.curvature_1pm(s - eps)).abs();
+        assert!(jump_h < 1e-8, "heading jump {jump_h:e} rad at s = {s}");
+        assert!(
+            jump_k * radius < 1e-6,
+            "curvature jump {jump_k:e} 1/m at s = {s}"
+        );
+        assert!((c.curvature_1pm(s) * radius - 1.0).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn smoothing_window_keeps_a_circle_and_tames_noise() {
+    let radius = 200.0;
+    let clean = arc([0.0, radius], radius, -0.5 * PI, 0.5, 1.0);
+    // Lateral noise of ±2 cm alternating at the vertices.
+    let noisy: Vec<[f64; 2]> = clean
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+            let r = [p[0], p[1] - radius];
+            let k = 1.0 + sign * 0.02 / radius;
+            [r[0] * k, r[1] * k + radius]
+        })
+        .collect();
+    let raw = Centreline::new(LaneId(1), &noisy, 0.05, 0.0).unwrap();
+    let smooth = Centreline::new(LaneId(1), &noisy, 0.05, 5.0).unwrap();
+    let mid = 0.5 * raw.length_m();
+    let err = |c: &Centreline| {
+        (mid - 20.0..mid + 20.0)
+            .step_by_f(0.25)
+            .into_iter()
+            .map(|s| (c.curvature_1pm(s) * radius - 1.0).abs())
+            .fold(0.0, f64::max)
+    };
+    assert!(
+        err(&raw) > 5.0,
+        "noise visible without smoothing: {}",
+        err(&raw)
+    );
+    assert!(
+        err(&smooth) < 0.1 * err(&raw),
+        "{} vs {}",
+        err(&smooth),
+        err(&raw)
+    );
+    // On the clean arc the window changes nothing beyond rounding.
+    let a = Centreline::new(LaneId(1), &clean, 0.05, 0.0).unwrap();
+    let b = Centreline::new(LaneId(1), &clean, 0.05, 5.0).unwrap();
+    for i in 0..100 {
+        let s = a.length_m() * i as f64 / 99.0;
+        assert!((a.curvature_1pm(s) - b.curvature_1pm(s)).abs() < 1e-9);
+        assert!((a.heading_rad(s) - b.heading_rad(s)).abs() < 1e-9);
+    }
+}
+
+trait StepBy {
+    fn step_by_f(self, step: f64) -> Vec<f64>;
+}
+impl StepBy for std::ops::Range<f64> {
+    fn step_by_f(self, step: f64) -> Vec<f64> {
+        let n = ((self.end - self.start) / step) as usize;
+        (0..n).map(|k| self.start + step * k as f64).collect()
+    }
+}
+
+/// Interpolated y of an x-monotone polyline at x.
+fn y_at(poly: &[[f64; 2]], x: f64) -> Option<f64> {
+    poly.windows(2).find_map(|w| {
+        (w[0][0] <= x && x <= w[1][0] && w[1][0] > w[0][0])
+            .then(|| w[0][1] + (w[1][1] - w[0][1]) * (x - w[0][0]) / (w[1][0] - w[0][0]))
+    })
+}
+
+/// Distance from p to a polyline.
+fn dist_to_polyline(poly: &[[f64; 2]], p: [f64; 2]) -> f64 {
+    poly.windows(2)
+        .map(|w| {
+            let e = [w[1][0] - w[0][0], w[1][1] - w[0][1]];
+            let t = (((p[0] - w[0][0]) * e[0] + (p[1] - w[0][1]) * e[1])
+                / (e[0] * e[0] + e[1] * e[1]))
+                .clamp(0.0, 1.0);
+            dist(p, [w[0][0] + t * e[0], w[0][1] + t * e[1]])
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn merge_road_as_lanes() {
+    let road = MergeRoad::default();
+    let lanes = road.lane_road().unwrap();
+    let through = lanes.lane(MergeRoad::lane_id(MergeLane::Upper)).unwrap();
+    let ending = lanes.lane(MergeRoad::lane_id(MergeLane::Lower)).unwrap();
+    // Lane centres.
+    for x in [-50.0, 0.0, 100.0, 159.0, 200.0, 259.0] {
+        let fp = ending.project([x, road.lane_center_y_m(MergeLane::Lower)]);
+        assert!(fp.d_m.abs() < 1e-12 && (fp.s_m - (x - road.start_x_m)).abs() < 1e-9);
+    }
+    for x in [-50.0, 100.0, 400.0, 700.0] {
+        assert!(
+            through
+                .project([x, road.lane_center_y_m(MergeLane::Upper)])
+                .d_m
+                .abs()
+                < 1e-12
+        );
+    }
+    // One divider, at y_lane, from the start to the merge end (has_divider).
+    let div = lanes.dividers();
+    assert_eq!(div.len(), 1);
+    assert_eq!(
+        (div[0].left_lane, div[0].right_lane),
+        (THROUGH_LANE_ID, ENDING_LANE_ID)
+    );
+    let first = div[0].polyline_m[0];
+    let last = div[0].polyline_m[div[0].polyline_m.len() - 1];
+    assert!((first[0] - road.start_x_m).abs() < 1e-9);
+    assert!((last[0] - road.merge_end_x_m).abs() < 1e-9);
+    for p in &div[0].polyline_m {
+        assert!((p[1] - road.y_lane_m()).abs() < 1e-12);
+    }
+    // Outer edges: the upper edge and the piecewise lower edge (with the taper and the lane end).
+    let edges = lanes.outer_edges();
+    assert_eq!(edges.len(), 2, "{edges:?}");
+    let lower = edges
+        .iter()
+        .find(|e| e.polyline_m[0][1] < road.y_lane_m())
+        .unwrap();
+    let upper = edges
+        .iter()
+        .find(|e| e.polyline_m[0][1] > road.y_lane_m())
+        .unwrap();
+    assert_eq!(lower.polyline_m.len(), road.lower_edge_polyline().len());
+    for (a, b) in lower.polyline_m.iter().zip(road.lower_edge_polyline()) {
+        assert!(dist(*a, b) < 1e-9, "{a:?} vs {b:?}");
+    }
+    for i in 0..=1500 {
+        let x = road.start_x_m + (road.end_x_m - road.start_x_m) * i as f64 / 1500.0;
+        let y = y_at(&lower.polyline_m, x).unwrap();
+        assert!((y - road.lower_edge_y_m(x)).abs() < 1e-9, "x = {x}");
+        assert!((y_at(&upper.polyline_m, x).unwrap() - road.y_upper_m()).abs() < 1e-12);
+    }
+    // The ending lane's end: closed, at the merge end, of zero width (the taper's tip).
+    let end = lanes.lane_end(ENDING_LANE_ID).unwrap();
+    assert!(end.closed);
+    assert!((end.edge_m[0][0] - road.merge_end_x_m).abs() < 1e-9);
+    assert!(dist(end.edge_m[0], end.edge_m[1]) < 1e-9);
+    assert!(!lanes.lane_end(THROUGH_LANE_ID).unwrap().closed);
+    // On the road, and the signed distance to the edges, at many points (off the boundaries).
+    let mut inside = 0;
+    for i in 0..120 {
+        for j in 0..40 {
+            let x = road.start_x_m - 5.0 + 760.0 * (i as f64 + 0.31) / 120.0;
+            let y = road.y_bottom_m - 1.0 + 9.0 * (j as f64 + 0.27) / 40.0;
+            let on_road = x >= road.start_x_m
+                && x <= road.end_x_m
+                && y >= road.lower_edge_y_m(x)
+                && y <= road.y_upper_m();
+            assert_eq!(lanes.is_drivable([x, y]), on_road, "({x}, {y})");
+            inside += usize::from(on_road);
+            let d = dist_to_polyline(&road.lower_edge_polyline(), [x, y])
+                .min(dist_to_polyline(&road.upper_edge_polyline(), [x, y]));
+            let expected = if on_road { d } else { -d };
+            let got = lanes.signed_distance_to_edge_m([x, y]);
+            assert!(
+                (got - expected).abs() < 1e-9,
+                "({x}, {y}): {got} vs {expected}"
+            );
+        }
+    }
+    assert!(inside > 1000);
+    // Which lane: both lanes before the taper's start hold a point on the divider.
+    let hits = lanes.lanes_at([100.0, road.y_lane_m()]);
+    assert_eq!(hits.len(), 2);
+    assert_eq!(lanes.nearest_lane([100.0, 1.0]).lane, ENDING_LANE_ID);
+    assert_eq!(lanes.nearest_lane([400.0, 1.0]).lane, THROUGH_LANE_ID);
+}
+
+#[test]
+fn curved_merge_road_has_its_divider_and_closed_end() {
+    let road = curved();
+    let m = MergeRoad::default();
+    assert_eq!(road.dividers().len(), 1);
+    assert_eq!(road.outer_edges().len(), 2);
+    let end = road.lane_end(ENDING_LANE_ID).unwrap();
+    assert!(end.closed);
+    let ending = road.lane(ENDING_LANE_ID).unwrap();
+    // The ending lane is the outer one on a left curve: its length scales by (R + w/2)/R.
+    let expected = (m.merge_end_x_m - m.start_x_m) * (R + 0.5 * m.lane_width_m) / R;
+    assert!(
+        (ending.length_m() - expected).abs() < 1e-3,
+        "{}",
+        ending.length_m()
+    );
+    // Mid-taper: the drivable part of the ending lane is the upper half.
+    let s = (0.5 * (m.merge_start_x_m + m.merge_end_x_m) - m.start_x_m)
+        * (R + 0.5 * m.lane_width_m)
+        / R;
+    assert!(road.is_drivable(ending.point(s, 0.2)));
+    assert!(!road.is_drivable(ending.point(s, -0.2)));
+    assert!((road.signed_distance_to_edge_m(ending.point(s, 0.2)) - 0.2).abs() < 0.01);
+}
+
+#[test]
+fn shared_bound_is_not_a_wall() {
+    let p = OnRampParams::default();
+    let road = LaneRoad::new(&on_ramp_spec(&p)).unwrap();
+    let w = p.lane_width_m;
+    // On the divider between the right main lane and the acceleration lane: drivable, and the
+    // nearest wall is a lane width away (the acceleration lane's right bound), not here.
+    let x = p.accel_start_x_m + 100.0;
+    assert!(road.is_drivable([x, 0.0]));
+    assert!((road.signed_distance_to_edge_m([x, 0.0]) - w).abs() < 1e-9);
+    // Before the acceleration lane, the same line is the road's edge.
+    assert!(road.signed_distance_to_edge_m([50.0, 0.0]).abs() < 1e-9);
+    assert!(road.signed_distance_to_edge_m([50.0, -0.1]) < 0.0);
+    // Dividers: 1|2 over the whole road, 2|3 along the acceleration lane.
+    let d23 = road
+        .dividers()
+        .iter()
+        .find(|d| d.right_lane == on_ramp_ids::ACCELERATION)
+        .unwrap();
+    assert_eq!(d23.left_lane, on_ramp_ids::MAIN_RIGHT);
+    assert!((d23.polyline_m[0][0] - p.accel_start_x_m).abs() < 1e-6);
+    let end_x = d23.polyline_m[d23.polyline_m.len() - 1][0];
+    assert!((end_x - (p.accel_start_x_m + p.accel_length_m + p.taper_length_m)).abs() < 1e-6);
+    assert!(
+        road.dividers()
+            .iter()
+            .any(|d| d.left_lane == on_ramp_ids::MAIN_LEFT
+                && d.right_lane == on_ramp_ids::MAIN_RIGHT)
+    );
+    // The ramp curves right at 1/150 m.
+    let ramp = road.lane(on_ramp_ids::RAMP).unwrap();
+    assert_eq!(ramp.kind(), LaneKind::Entry);
+    assert!((ramp.curvature_1pm(0.5 * ramp.length_m()) * p.ramp_radius_m + 1.0).abs() < 1e-5);
+    assert_eq!(
+        road.lane(on_ramp_ids::ACCELERATION).unwrap().predecessors(),
+        &[on_ramp_ids::RAMP]
+    );
+    assert_eq!(ramp.successors(), &[on_ramp_ids::ACCELERATION]);
+}
+
+#[test]
+fn lane_end_closes() {
+    let p = OnRampParams {
+        taper_length_m: 0.0,
+        ..OnRampParams::default()
+    };
+    let road = LaneRoad::new(&on_ramp_spec(&p)).unwrap();
+    let w = p.lane_width_m;
+    let x_end = p.accel_start_x_m + p.accel_length_m;
+    let end = road.lane_end(on_ramp_ids::ACCELERATION).unwrap();
+    assert!(end.closed);
+    assert!(dist(end.edge_m[0], [x_end, -w]) < 1e-9);
+    assert!(dist(end.edge_m[1], [x_end, 0.0]) < 1e-9);
+    // Main lanes end open at the road's end.
+    assert!(!road.lane_end(on_ramp_ids::MAIN_RIGHT).unwrap().closed);
+    // Just before the end: drivable, 0.3 m from the edge across the end.
+    assert!((road.signed_distance_to_edge_m([x_end - 0.3, -0.5 * w]) - 0.3).abs() < 1e-9);
+    assert!(!road.is_drivable([x_end + 0.3, -0.5 * w]));
+    assert!((road.signed_distance_to_edge_m([x_end + 0.3, -0.5 * w]) + 0.3).abs() < 1e-9);
+    // The right edge runs along the acceleration lane, across its end, then along lane 2.
+    let chained = road.outer_edges().iter().find(|e| {
+        e.polyline_m
+            .windows(2)
+            .any(|s| dist(s[0], [x_end, -w]) < 1e-9 && dist(s[1], [x_end, 0.0]) < 1e-9)
+    });
+    let chained = chained.expect("an edge across the acceleration lane's end");
+    let last = chained.polyline_m[chained.polyline_m.len() - 1];
+    assert!(dist(last, [p.main_length_m, 0.0]) < 1e-9, "{last:?}");
+}
+
+#[test]
+fn y_merge_joins_two_lanes_into_one() {
+    let w = 3.5;
+    let mut a = LaneSpec::new(LaneId(1), vec![[0.0, 2.0], [50.0, 0.5]], w);
+    a.successors = vec![LaneId(3)];
+    let mut b = LaneSpec::new(LaneId(2), vec![[0.0, -2.0], [50.0, -0.5]], w);
+    b.successors = vec![LaneId(3)];
+    let c = LaneSpec::new(LaneId(3), vec![[50.0, 0.0], [150.0, 0.0]], w);
+    let road = LaneRoad::new(&LaneRoadSpec {
+        lanes: vec![a, b, c],
+        tolerances: LaneTolerances::default(),
+    })
+    .unwrap();
+    assert_eq!(
+        road.lane(LaneId(3)).unwrap().predecessors(),
+        &[LaneId(1), LaneId(2)]
+    );
+    assert!(road.is_drivable([49.0, 0.0]));
+    assert!(road.is_drivable([100.0, 1.7]));
+    assert!(road.lane_end(LaneId(1)).is_none());
+}
+
+fn two_lanes() -> LaneRoadSpec {
+    let mut a = LaneSpec::new(LaneId(1), vec![[0.0, 1.75], [100.0, 1.75]], 3.5);
+    a.left = Some(LaneId(2));
+    let mut b = LaneSpec::new(LaneId(2), vec![[0.0, 5.25], [100.0, 5.25]], 3.5);
+    b.right = Some(LaneId(1));
+    b.successors = vec![LaneId(3)];
+    let c = LaneSpec::new(LaneId(3), vec![[100.0, 5.25], [200.0, 5.25]], 3.5);
+    LaneRoadSpec {
+        lanes: vec![a, b, c],
+        tolerances: LaneTolerances::default(),
+    }
+}
+
+fn refused(edit: impl FnOnce(&mut LaneRoadSpec)) -> LaneError {
+    let mut spec = two_lanes();
+    edit(&mut spec);
+    LaneRoad::new(&spec).unwrap_err()
+}
+
+#[test]
+fn inconsistent_lane_data_is_refused_naming_lane_and_field() {
+    assert!(LaneRoad::new(&two_lanes()).is_ok());
+    let cases: Vec<(LaneError, Option<u32>, &str, &str)> = vec![
+        (refused(|s| s.lanes.clear()), None, "lanes", "no lanes"),
+        (
+            refused(|s| s.lanes[2].id = LaneId(1)),
+            Some(1),
+            "id",
+            "used by two",
+        ),
+        (
+            refused(|s| s.lanes[0].centreline_m[1][0] = f64::NAN),
+            Some(1),
+            "centreline_m",
+            "not finite",
+        ),
+        (
+            refused(|s| s.lanes[0].centreline_m = vec![[0.0, 0.0], [0.0, 0.0], [0.01, 0.0]]),
+            Some(1),
+            "centreline_m",
+            "1 distinct",
+        ),
+        (
+            refused(|s| s.lanes[2].centreline_m = vec![[100.0, 5.25], [150.0, 5.25], [120.0, 5.3]]),
+            Some(3),
+            "centreline_m",
+            "turns",
+        ),
+        (
+            refused(|s| s.lanes[0].width_m = vec![3.5, 3.0, 2.0]),
+            Some(1),
+            "width_m",
+            "3 values",
+        ),
+        (
+            refused(|s| s.lanes[0].width_m.clear()),
+            Some(1),
+            "width_m",
+            "missing",
+        ),
+        (
+            refused(|s| s.lanes[0].left_width_m = vec![1.0]),
+            Some(1),
+            "width_m",
+            "alone",
+        ),
+        (
+            refused(|s| {
+                s.lanes[0].width_m.clear();
+                s.lanes[0].left_width_m = vec![1.0];
+            }),
+            Some(1),
+            "right_width_m",
+            "missing",
+        ),
+        (
+            refused(|s| s.lanes[1].width_m = vec![-3.5]),
+            Some(2),
+            "width_m",
+            "positive",
+        ),
+        (
+            refused(|s| {
+                s.lanes[2].centreline_m.insert(1, [150.0, 5.25]);
+                s.lanes[2].width_m = vec![3.5, 0.0, 3.5];
+            }),
+            Some(3),
+            "width_m",
+            "positive",
+        ),
+        (
+            refused(|s| s.lanes[1].successors = vec![LaneId(9)]),
+            Some(2),
+            "successors",
+            "does not exist",
+        ),
+        (
+            refused(|s| s.lanes[0].left = Some(LaneId(1))),
+            Some(1),
+            "left",
+            "itself",
+        ),
+        (
+            refused(|s| s.lanes[2].centreline_m = vec![[101.0, 5.25], [200.0, 5.25]]),
+            Some(2),
+            "successors",
+            "from the start of lane 3",
+        ),
+        (
+            refused(|s| {
+                s.lanes[1].successors.clear();
+                s.lanes[2].predecessors = vec![LaneId(2)];
+                s.lanes[2].centreline_m = vec![[100.0, 9.0], [200.0, 9.0]];
+            }),
+            Some(3),
+            "predecessors",
+            "lane 2 ends",
+        ),
+        (
+            refused(|s| s.lanes[1].centreline_m = vec![[0.0, 6.0], [100.0, 6.0]]),
+            Some(1),
+            "left",
+            "not beside",
+        ),
+        (
+            // Beside, but driving the other way.
+            refused(|s| {
+                s.lanes[1].centreline_m = vec![[100.0, 5.25], [0.0, 5.25]];
+                s.lanes[1].successors.clear();
+            }),
+            Some(1),
+            "left",
+            "not beside",
+        ),
+        (
+            refused(|s| s.tolerances.link_m = 0.0),
+            None,
+            "link_m",
+            "(0, 5]",
+        ),
+    ];
+    for (err, lane, field, words) in cases {
+        let msg = err.to_string();
+        assert_eq!(err.lane().map(|l| l.0), lane, "{msg}");
+        assert_eq!(err.field(), field, "{msg}");
+        assert!(msg.contains(words), "{msg:?} lacks {words:?}");
+        if let Some(l) = lane {
+            assert!(msg.starts_with(&format!("lane {l}: {field}")), "{msg}");
+        }
+    }
+}
+
+#[test]
+fn lane_data_reads_from_toml() {
+    let text = r#"
+        [[lanes]]
+        id = 1
+        centreline_m = [[0.0, 1.75], [100.0, 1.75]]
+        width_m = [3.5]
+        left = 2
+
+        [[lanes]]
+        id = 2
+        kind = "entry"
+        centreline_m = [[0.0, 5.25], [50.0, 5.25], [100.0, 5.25]]
+        left_width_m = [1.75]
+        right_width_m = [1.75, 1.75, 1.75]
+        right = 1
+
+        [tolerances]
+        vertex_merge_m = 0.01
+    "#;
+    let spec: LaneRoadSpec = toml::from_str(text).unwrap();
+    assert_eq!(spec.lanes[1].kind, LaneKind::Entry);
+    assert_eq!(spec.tolerances.vertex_merge_m, 0.01);
+    let road = LaneRoad::new(&spec).unwrap();
+    assert_eq!(road.dividers().len(), 1);
+    // And back.
+    let again: LaneRoadSpec = toml::from_str(&toml::to_string(&spec).unwrap()).unwrap();
+    assert_eq!(again, spec);
+    let bad = toml::from_str::<LaneRoadSpec>("[[lanes]]\nid = 1\ncentreline = []\n");
+    assert!(bad.unwrap_err().to_string().contains("centreline"));
+}
+
+fn transform(spec: &LaneRoadSpec, angle: f64, shift: [f64; 2]) -> LaneRoadSpec {
+    let (sn, cs) = angle.sin_cos();
+    let mut out = spec.clone();
+    for l in &mut out.lanes {
+        for p in &mut l.centreline_m {
+            *p = [
+                cs * p[0] - sn * p[1] + shift[0],
+                sn * p[0] + cs * p[1] + shift[1],
+            ];
+        }
+    }
+    out
+}
+
+#[test]
+fn rotated_and_shifted_road_projects_the_same() {
+    let spec = curved_merge_spec(&MergeRoad::default(), R);
+    let (angle, shift) = (2.1, [5900.0, -3100.0]);
+    let a = LaneRoad::new(&spec).unwrap();
+    let b = LaneRoad::new(&transform(&spec, angle, shift)).unwrap();
+    let (sn, cs) = angle.sin_cos();
+    let mut worst: f64 = 0.0;
+    for id in [THROUGH_LANE_ID, ENDING_LANE_ID] {
+        let (la, lb) = (a.lane(id).unwrap(), b.lane(id).unwrap());
+        for i in 0..500 {
+            let p = la.point(
+                la.length_m() * (i as f64 + 0.5) / 500.0,
+                3.0 * ((i % 13) as f64 / 6.0 - 1.0),
+            );
+            let q = [
+                cs * p[0] - sn * p[1] + shift[0],
+                sn * p[0] + cs * p[1] + shift[1],
+            ];
+            let (fa, fb) = (la.project(p), lb.project(q));
+            worst = worst
+                .max((fa.s_m - fb.s_m).abs())
+                .max((fa.d_m - fb.d_m).abs());
+            assert!((la.curvature_1pm(fa.s_m) - lb.curvature_1pm(fb.s_m)).abs() < 1e-9);
+            assert_eq!(a.is_drivable(p), b.is_drivable(q));
+        }
+    }
+    assert!(worst < 1e-9, "(s, d) differ by {worst:e} m");
+}
+
+#[test]
+fn far_from_origin_projects_as_accurately() {
+    let spec = curved_merge_spec(&MergeRoad::default(), R);
+    let shift = [5900.0, 5900.0];
+    let near = LaneRoad::new(&spec).unwrap();
+    let far = LaneRoad::new(&transform(&spec, 0.0, shift)).unwrap();
+    let round_trip = |road: &LaneRoad| {
+        let lane = road.lane(THROUGH_LANE_ID).unwrap();
+        let mut worst: f64 = 0.0;
+        for i in 0..1000 {
+            let s = lane.length_m() * (i as f64 + 0.5) / 1000.0;
+            let d = 3.0 * ((i % 17) as f64 / 8.0 - 1.0);
+            let fp = lane.project(lane.point(s, d));
+            worst = worst.max((fp.s_m - s).abs()).max((fp.d_m - d).abs());
+        }
+        worst
+    };
+    let (e_near, e_far) = (round_trip(&near), round_trip(&far));
+    assert!(
+        e_near < 1e-9 && e_far < 1e-9,
+        "near {e_near:e}, far {e_far:e}"
+    );
+    let m = MergeRoad::default();
+    let p = [200.0, m.y_lane_m() + 0.3];
+    let q = [p[0] + shift[0], p[1] + shift[1]];
+    let (dn, df) = (
+        near.signed_distance_to_edge_m(p),
+        far.signed_distance_to_edge_m(q),
+    );
+    assert!((dn - df).abs() < 1e-9, "{dn} vs {df}");
+}
