@@ -696,3 +696,40 @@ fn far_from_origin_projects_as_accurately() {
     );
     assert!((dn - df).abs() < 1e-9, "{dn} vs {df}");
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+    /// Arcs of any radius, sampling, orientation and place: (s, d) round trips, and the
+    /// curvature within the stated bound c²/(16R²) (plus higher orders: factor 1.05, and the
+    /// input's rounding).
+    #[test]
+    fn random_arcs_round_trip(
+        radius in 50.0f64..3000.0,
+        sweep in 0.05f64..1.5,
+        step in 0.3f64..5.0,
+        start_angle in -PI..PI,
+        left in proptest::bool::ANY,
+        shift_x in -10_000.0f64..10_000.0,
+        shift_y in -10_000.0f64..10_000.0,
+        u in 0.0f64..1.0,
+        v in -1.0f64..1.0,
+    ) {
+        let sweep = if left { sweep } else { -sweep };
+        let pts = arc([shift_x, shift_y], radius, start_angle, sweep, step);
+        let chord = dist(pts[0], pts[1]);
+        let lane = Centreline::new(LaneId(1), &pts, 0.05, 0.0).unwrap();
+        let s = lane.length_m() * u;
+        let d = v * (0.25 * radius).min(10.0);
+        let p = lane.point(s, d);
+        let fp = lane.project(p);
+        proptest::prop_assert!((fp.s_m - s).abs() < 1e-9 && (fp.d_m - d).abs() < 1e-9,
+            "({}, {}) vs ({s}, {d})", fp.s_m, fp.d_m);
+        let k = lane.curvature_1pm(s) * radius * sweep.signum();
+        // Plus the input's own rounding: vertices carry an ulp of their coordinates (δ), which
+        // the chord-to-chord turn (≈ c/R) feels as a relative error of order 2δ·R/c².
+        let coord = shift_x.abs().max(shift_y.abs()) + radius;
+        let rounding = 4.0 * f64::EPSILON * coord * radius / (chord * chord);
+        let bound = 1.05 * chord * chord / (16.0 * radius * radius) + rounding;
+        proptest::prop_assert!((k - 1.0).abs() <= bound, "relative error {} > {bound}", (k - 1.0).abs());
+    }
+}

@@ -26,8 +26,13 @@
 //!   derivative: the heading is C¹ and the curvature continuous in s, so nothing jumps at a
 //!   vertex. Error bound: for vertices sampled on a circle of radius R with chords ≤ c, vertex
 //!   curvatures and headings are exact, and between vertices the curvature is within a
-//!   relative c²/(4R²) + O(c⁴/R⁴) of 1/R (the Hermite slopes L·κ versus the chord's central
-//!   angle 2·asin(L/2R)); c = 1 m, R = 150 m: 1.1e-5. The frame's own normal N(t) follows the
+//!   relative c²/(16R²) + O(c⁴/R⁴) of 1/R (the Hermite slopes 2·sin(Δφ/2) versus the central
+//!   angle Δφ ≈ c/R: the error is 6u(1−u)·Δφ²/24 at u along the chord); c = 1 m, R = 150 m:
+//!   2.8e-6 (tests `arc_heading_and_curvature_match_the_circle`, `random_arcs_round_trip`).
+//!   Add the data's own rounding: vertices carrying an error δ (an ulp of their coordinates,
+//!   1.8e-12 m at 10 km) give a relative curvature error of order 2δ·R/c², so arcs sampled far
+//!   more finely than their radius needs lose curvature digits far from the origin.
+//!   The frame's own normal N(t) follows the
 //!   bisectors, so it can differ from the smoothed heading's normal by at most half the turn at
 //!   a vertex (0 for uniformly sampled arcs).
 //!
