@@ -23,7 +23,8 @@ fn queries(road: &LaneRoad) -> Vec<[f64; 2]> {
 }
 
 fn bench(c: &mut Criterion) {
-    let road = LaneRoad::new(&curved_merge_spec(&MergeRoad::default(), 300.0)).expect("road");
+    let road = LaneRoad::new(&curved_merge_spec(&MergeRoad::default(), 300.0).expect("spec"))
+        .expect("road");
     let lane = road.lane(THROUGH_LANE_ID).expect("lane 1");
     let pts = queries(&road);
     c.bench_function("project_1000_points_curved_lane", |b| {

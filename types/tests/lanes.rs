@@ -12,7 +12,7 @@ use mergesim_types::{Lane as MergeLane, MergeRoad};
 const R: f64 = 300.0;
 
 fn curved() -> LaneRoad {
-    LaneRoad::new(&curved_merge_spec(&MergeRoad::default(), R)).unwrap()
+    LaneRoad::new(&curved_merge_spec(&MergeRoad::default(), R).unwrap()).unwrap()
 }
 
 /// Points of a circular arc about `c`, radius `r`, from angle `a0` over `sweep` (rad), chords of
@@ -348,7 +348,7 @@ fn curved_merge_road_has_its_divider_and_closed_end() {
 #[test]
 fn shared_bound_is_not_a_wall() {
     let p = OnRampParams::default();
-    let road = LaneRoad::new(&on_ramp_spec(&p)).unwrap();
+    let road = LaneRoad::new(&on_ramp_spec(&p).unwrap()).unwrap();
     let w = p.lane_width_m;
     // On the divider between the right main lane and the acceleration lane: drivable, and the
     // nearest wall is a lane width away (the acceleration lane's right bound), not here.
@@ -391,7 +391,7 @@ fn lane_end_closes() {
         taper_length_m: 0.0,
         ..OnRampParams::default()
     };
-    let road = LaneRoad::new(&on_ramp_spec(&p)).unwrap();
+    let road = LaneRoad::new(&on_ramp_spec(&p).unwrap()).unwrap();
     let w = p.lane_width_m;
     let x_end = p.accel_start_x_m + p.accel_length_m;
     let end = road.lane_end(on_ramp_ids::ACCELERATION).unwrap();
@@ -637,7 +637,7 @@ fn transform(spec: &LaneRoadSpec, angle: f64, shift: [f64; 2]) -> LaneRoadSpec {
 
 #[test]
 fn rotated_and_shifted_road_projects_the_same() {
-    let spec = curved_merge_spec(&MergeRoad::default(), R);
+    let spec = curved_merge_spec(&MergeRoad::default(), R).unwrap();
     let (angle, shift) = (2.1, [5900.0, -3100.0]);
     let a = LaneRoad::new(&spec).unwrap();
     let b = LaneRoad::new(&transform(&spec, angle, shift)).unwrap();
@@ -667,7 +667,7 @@ fn rotated_and_shifted_road_projects_the_same() {
 
 #[test]
 fn far_from_origin_projects_as_accurately() {
-    let spec = curved_merge_spec(&MergeRoad::default(), R);
+    let spec = curved_merge_spec(&MergeRoad::default(), R).unwrap();
     let shift = [5900.0, 5900.0];
     let near = LaneRoad::new(&spec).unwrap();
     let far = LaneRoad::new(&transform(&spec, 0.0, shift)).unwrap();
@@ -732,4 +732,66 @@ proptest::proptest! {
         let bound = 1.05 * chord * chord / (16.0 * radius * radius) + rounding;
         proptest::prop_assert!((k - 1.0).abs() <= bound, "relative error {} > {bound}", (k - 1.0).abs());
     }
+}
+
+#[test]
+fn bound_inside_another_lane_is_not_a_wall() {
+    // A shoulder drawn overlapping half of the main lane (its left bound lies inside the main
+    // lane, the main lane's right bound inside the shoulder): only the two outer lines are walls.
+    let main = LaneSpec::new(LaneId(1), vec![[0.0, 1.75], [100.0, 1.75]], 3.5);
+    let shoulder = LaneSpec {
+        kind: LaneKind::Shoulder,
+        ..LaneSpec::new(LaneId(2), vec![[0.0, 0.0], [100.0, 0.0]], 2.5)
+    };
+    let road = LaneRoad::new(&LaneRoadSpec {
+        lanes: vec![main, shoulder],
+        tolerances: LaneTolerances::default(),
+    })
+    .unwrap();
+    let mut ys: Vec<f64> = road
+        .outer_edges()
+        .iter()
+        .map(|e| {
+            assert!(e.polyline_m.iter().all(|p| p[1] == e.polyline_m[0][1]));
+            e.polyline_m[0][1]
+        })
+        .collect();
+    ys.sort_by(f64::total_cmp);
+    assert_eq!(ys, vec![-1.25, 3.5]);
+    for y in [-1.0, 0.0, 1.25, 1.3, 3.4] {
+        assert!(road.is_drivable([50.0, y]));
+        let expected = (y + 1.25).min(3.5 - y);
+        assert!((road.signed_distance_to_edge_m([50.0, y]) - expected).abs() < 1e-9);
+    }
+    assert!(road.dividers().is_empty());
+}
+
+#[test]
+fn builders_refuse_bad_parameters() {
+    let e = curved_merge_spec(&MergeRoad::default(), 5.0).unwrap_err();
+    assert_eq!(e.name, "radius_m");
+    assert!(curved_merge_spec(&MergeRoad::default(), f64::NAN).is_err());
+    // 750 m of road on a 100 m radius would turn 7.5 rad.
+    assert!(curved_merge_spec(&MergeRoad::default(), 100.0).is_err());
+    assert!(curved_merge_spec(&MergeRoad::default(), -300.0).is_ok());
+    let short = OnRampParams {
+        main_length_m: 400.0,
+        ..OnRampParams::default()
+    };
+    assert_eq!(
+        on_ramp_spec(&short).unwrap_err().name,
+        "on_ramp.main_length_m"
+    );
+    let huge = OnRampParams {
+        ramp_radius_m: 1e300,
+        ..OnRampParams::default()
+    };
+    assert_eq!(
+        on_ramp_spec(&huge).unwrap_err().name,
+        "on_ramp.ramp_radius_m"
+    );
+    // A right curve builds and curves right.
+    let right = LaneRoad::new(&curved_merge_spec(&MergeRoad::default(), -300.0).unwrap()).unwrap();
+    let lane = right.lane(THROUGH_LANE_ID).unwrap();
+    assert!((lane.curvature_1pm(100.0) * (300.0 + 1.75) + 1.0).abs() < 1e-5);
 }

@@ -4,6 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::spec::{LaneId, LaneKind, LaneRoadSpec, LaneSpec, LaneTolerances};
+use crate::bounds::{Bound, check_all};
+use crate::error::InvalidParameter;
 use crate::road::MergeRoad;
 
 /// Id of the merge road's through lane (the upper lane, [`crate::Lane::Upper`]).
@@ -85,14 +87,39 @@ pub fn merge_road_spec(road: &MergeRoad) -> LaneRoadSpec {
 /// road goes to angle x / R on the circle of radius R − (y − y_lane) about (0, y_lane + R), so
 /// lateral offsets are kept and arc length along the divider equals x. Centrelines are sampled
 /// at most [`ARC_STEP_M`] apart (on the divider's scale). A negative radius turns right.
-pub fn curved_merge_spec(road: &MergeRoad, radius_m: f64) -> LaneRoadSpec {
+///
+/// Refused (naming the field): a road [`MergeRoad::validate`] refuses, or |radius| outside
+/// [`CURVED_MERGE_RADIUS_M`] or smaller than the road's length / 6 (the lanes must not turn
+/// further than 6 rad).
+pub fn curved_merge_spec(
+    road: &MergeRoad,
+    radius_m: f64,
+) -> Result<LaneRoadSpec, InvalidParameter> {
+    road.validate()?;
+    let [lo, hi] = CURVED_MERGE_RADIUS_M;
+    let length_m = road.end_x_m - road.start_x_m;
+    if !(radius_m.is_finite() && (lo..=hi).contains(&radius_m.abs()))
+        || length_m / radius_m.abs() > 6.0
+    {
+        return Err(InvalidParameter::new(
+            "radius_m",
+            radius_m,
+            format!(
+                "|radius| must lie in [{lo}, {hi}] m and be at least the road's length / 6 ({} m)",
+                length_m / 6.0
+            ),
+        ));
+    }
     let y_lane = road.y_lane_m();
-    merge_lanes(road, ARC_STEP_M, &|x, y| {
+    Ok(merge_lanes(road, ARC_STEP_M, &|x, y| {
         let phi = x / radius_m;
         let r = radius_m - (y - y_lane);
         [r * phi.sin(), y_lane + radius_m - r * phi.cos()]
-    })
+    }))
 }
+
+/// Allowed |radius| of [`curved_merge_spec`] (m).
+pub const CURVED_MERGE_RADIUS_M: [f64; 2] = [20.0, 100_000.0];
 
 /// An on-ramp: a two-lane main road along +x with a parallel acceleration lane on its right,
 /// entered from a ramp on a circular arc.
@@ -129,6 +156,54 @@ impl Default for OnRampParams {
     }
 }
 
+/// Allowed ranges of [`OnRampParams`].
+pub const ON_RAMP_BOUNDS: &[Bound] = &[
+    Bound::closed("lane_width_m", 2.0, 6.0, "m"),
+    Bound::closed("ramp_radius_m", 20.0, 10_000.0, "m"),
+    Bound::closed("ramp_angle_rad", 0.01, 1.6, "rad"),
+    Bound::closed("accel_start_x_m", 0.0, 10_000.0, "m"),
+    Bound::closed("accel_length_m", 10.0, 5_000.0, "m"),
+    Bound::closed("taper_length_m", 0.0, 1_000.0, "m"),
+    Bound::closed("main_length_m", 10.0, 20_000.0, "m"),
+];
+
+impl OnRampParams {
+    /// Checks every field against [`ON_RAMP_BOUNDS`], and that the main road reaches past the
+    /// acceleration lane and the ramp starts at x ≥ 0.
+    pub fn validate(&self) -> Result<(), InvalidParameter> {
+        check_all(
+            "on_ramp",
+            ON_RAMP_BOUNDS,
+            &[
+                ("lane_width_m", self.lane_width_m),
+                ("ramp_radius_m", self.ramp_radius_m),
+                ("ramp_angle_rad", self.ramp_angle_rad),
+                ("accel_start_x_m", self.accel_start_x_m),
+                ("accel_length_m", self.accel_length_m),
+                ("taper_length_m", self.taper_length_m),
+                ("main_length_m", self.main_length_m),
+            ],
+        )?;
+        let accel_end_m = self.accel_start_x_m + self.accel_length_m + self.taper_length_m;
+        if self.main_length_m <= accel_end_m {
+            return Err(InvalidParameter::new(
+                "on_ramp.main_length_m",
+                self.main_length_m,
+                format!("must exceed the acceleration lane's end, x = {accel_end_m} m"),
+            ));
+        }
+        let ramp_start_x_m = self.accel_start_x_m - self.ramp_radius_m * self.ramp_angle_rad.sin();
+        if ramp_start_x_m < 0.0 {
+            return Err(InvalidParameter::new(
+                "on_ramp.accel_start_x_m",
+                self.accel_start_x_m,
+                format!("the ramp would start at x = {ramp_start_x_m:.1} m, before the main road"),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Ids of the on-ramp road's lanes.
 pub mod on_ramp_ids {
     use super::LaneId;
@@ -146,8 +221,10 @@ pub mod on_ramp_ids {
 /// to `main_length_m`; the acceleration lane 3 (centre y = −0.5 w) from `accel_start_x_m`,
 /// `accel_length_m` at full width, then its taper; the ramp 4, an arc of `ramp_radius_m` turning
 /// right through `ramp_angle_rad` to meet lane 3's start tangentially (sampled ≤ 1 m apart).
-pub fn on_ramp_spec(p: &OnRampParams) -> LaneRoadSpec {
+/// Refused (naming the field) when [`OnRampParams::validate`] refuses.
+pub fn on_ramp_spec(p: &OnRampParams) -> Result<LaneRoadSpec, InvalidParameter> {
     use on_ramp_ids::*;
+    p.validate()?;
     let w = p.lane_width_m;
     let main = |id, y, left, right| LaneSpec {
         left,
@@ -188,7 +265,7 @@ pub fn on_ramp_spec(p: &OnRampParams) -> LaneRoadSpec {
         successors: vec![ACCELERATION],
         ..LaneSpec::new(RAMP, ramp_pts, w)
     };
-    LaneRoadSpec {
+    Ok(LaneRoadSpec {
         lanes: vec![
             main(MAIN_LEFT, 1.5 * w, None, Some(MAIN_RIGHT)),
             main(MAIN_RIGHT, 0.5 * w, Some(MAIN_LEFT), Some(ACCELERATION)),
@@ -196,5 +273,5 @@ pub fn on_ramp_spec(p: &OnRampParams) -> LaneRoadSpec {
             ramp,
         ],
         tolerances: LaneTolerances::default(),
-    }
+    })
 }
