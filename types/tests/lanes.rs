@@ -795,3 +795,26 @@ fn builders_refuse_bad_parameters() {
     let lane = right.lane(THROUGH_LANE_ID).unwrap();
     assert!((lane.curvature_1pm(100.0) * (300.0 + 1.75) + 1.0).abs() < 1e-5);
 }
+
+#[test]
+fn distance_to_a_closed_end_follows_successors() {
+    let m = MergeRoad::default();
+    let merge = m.lane_road().unwrap();
+    let d = merge
+        .distance_to_closed_end_m(ENDING_LANE_ID, 10.0)
+        .unwrap();
+    assert!((d - (m.merge_end_x_m - m.start_x_m - 10.0)).abs() < 1e-9);
+    assert_eq!(merge.distance_to_closed_end_m(THROUGH_LANE_ID, 10.0), None);
+    let p = OnRampParams::default();
+    let ramp_road = LaneRoad::new(&on_ramp_spec(&p).unwrap()).unwrap();
+    let ramp_len = ramp_road.lane(on_ramp_ids::RAMP).unwrap().length_m();
+    let d = ramp_road
+        .distance_to_closed_end_m(on_ramp_ids::RAMP, 0.0)
+        .unwrap();
+    assert!((d - (ramp_len + p.accel_length_m + p.taper_length_m)).abs() < 1e-9);
+    assert_eq!(
+        ramp_road.distance_to_closed_end_m(on_ramp_ids::MAIN_RIGHT, 0.0),
+        None
+    );
+    assert_eq!(ramp_road.distance_to_closed_end_m(LaneId(99), 0.0), None);
+}

@@ -445,6 +445,45 @@ impl LaneRoad {
         self.lane_ends.iter().find(|e| e.lane == id)
     }
 
+    /// How far ahead (m, along the centrelines) the lane holding `s_m` on lane `id` must be
+    /// left: following the successors, every branch ends closed ([`LaneEnd::closed`]), and this
+    /// is the longest such branch. `None` if some branch goes on to the road's open end (or
+    /// loops), or the lane does not exist. For the lane rule "a lane that ends ahead is never a
+    /// target" (issue 21, item 4).
+    pub fn distance_to_closed_end_m(&self, id: LaneId, s_m: f64) -> Option<f64> {
+        let mut on_path = Vec::new();
+        self.closed_end_from(id, &mut on_path)
+            .map(|d| d - s_m.clamp(0.0, self.lane(id).map_or(0.0, Lane::length_m)))
+    }
+
+    /// Distance from the start of lane `id` to its closed end, as above.
+    fn closed_end_from(&self, id: LaneId, on_path: &mut Vec<LaneId>) -> Option<f64> {
+        if on_path.contains(&id) {
+            return None;
+        }
+        let lane = self.lane(id)?;
+        if lane.successors.is_empty() {
+            return self
+                .lane_end(id)
+                .filter(|e| e.closed)
+                .map(|_| lane.length_m());
+        }
+        on_path.push(id);
+        let mut longest: f64 = 0.0;
+        for next in &lane.successors {
+            let d = self.closed_end_from(*next, on_path);
+            match d {
+                Some(d) => longest = longest.max(d),
+                None => {
+                    on_path.pop();
+                    return None;
+                }
+            }
+        }
+        on_path.pop();
+        Some(lane.length_m() + longest)
+    }
+
     /// Index tree query used by the drivable-area builder: lanes whose boxes overlap lane `i`'s.
     pub(crate) fn overlapping_lanes(&self, i: usize) -> Vec<usize> {
         let Some(b) = self.lane_boxes.iter().find(|b| b.data == i) else {
