@@ -89,7 +89,7 @@ pub fn merge_road_spec(road: &MergeRoad) -> LaneRoadSpec {
 /// at most [`ARC_STEP_M`] apart (on the divider's scale). A negative radius turns right.
 ///
 /// Refused (naming the field): a road [`MergeRoad::validate`] refuses, or |radius| outside
-/// [`CURVED_MERGE_RADIUS_M`] or smaller than the road's length / 6 (the lanes must not turn
+/// [`CURVED_MERGE_RADIUS_M`](crate::lanes::CURVED_MERGE_RADIUS_M) or smaller than the road's length / 6 (the lanes must not turn
 /// further than 6 rad).
 pub fn curved_merge_spec(
     road: &MergeRoad,
@@ -168,7 +168,7 @@ pub const ON_RAMP_BOUNDS: &[Bound] = &[
 ];
 
 impl OnRampParams {
-    /// Checks every field against [`ON_RAMP_BOUNDS`], and that the main road reaches past the
+    /// Checks every field against [`ON_RAMP_BOUNDS`](crate::lanes::ON_RAMP_BOUNDS), and that the main road reaches past the
     /// acceleration lane and the ramp starts at x ≥ 0.
     pub fn validate(&self) -> Result<(), InvalidParameter> {
         check_all(

@@ -84,8 +84,8 @@ mod polyline;
 mod spec;
 
 pub use builders::{
-    ARC_STEP_M, ENDING_LANE_ID, OnRampParams, THROUGH_LANE_ID, curved_merge_spec, merge_road_spec,
-    on_ramp_ids, on_ramp_spec,
+    ARC_STEP_M, CURVED_MERGE_RADIUS_M, ENDING_LANE_ID, ON_RAMP_BOUNDS, OnRampParams,
+    THROUGH_LANE_ID, curved_merge_spec, merge_road_spec, on_ramp_ids, on_ramp_spec,
 };
 pub use error::LaneError;
 pub use lane::{Lane, Side};
