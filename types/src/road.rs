@@ -214,7 +214,7 @@ impl MergeRoad {
 
     /// This road as a [`LaneRoad`]: the through lane, the ending lane with its (closed) end, the
     /// divider up to `merge_end_x_m`, the outer edges (upper edge; lower edge with the taper).
-    /// Its queries give this road's figures (test `merge_road_as_lanes` in types/tests/lanes.rs).
+    /// Its queries give this road's figures (test `merge_road_as_lanes` in types/tests/lanes_road.rs).
     /// Fails only for a road that [`Self::validate`] refuses.
     pub fn lane_road(&self) -> Result<LaneRoad, LaneError> {
         LaneRoad::new(&self.lane_road_spec())
