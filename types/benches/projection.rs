@@ -2,6 +2,13 @@
 //! road (300 m radius, ~750 vertices 1 m apart) and the road-level queries.
 //!
 //! `cargo bench -p mergesim-types --bench projection`
+//!
+//! Measured 2026-12-02 (`-- --warm-up-time 2 --measurement-time 6`, shared 2-core machine under
+//! a load average of ~12, so upper bounds): 787 µs per 1000 projections (0.79 µs each), 70 µs
+//! per 1000 `point(s, d)`, 3.9 ms per 1000 `signed_distance_to_edge_m` (projection onto both
+//! lanes + nearest outer edge). A variant looking up the nearest segment and then every segment
+//! within reach (`locate_within_distance`) measured 2.4 ms per 1000: the nearest-first iterator
+//! stays.
 
 use std::hint::black_box;
 
