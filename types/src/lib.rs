@@ -1,4 +1,5 @@
-//! Plain data shared by mergesim's crates: the merge road's geometry, a vehicle's state and
+//! Plain data shared by mergesim's crates: the merge road's geometry, roads made of lanes (the
+//! curvilinear lane frame, [`lanes`]), a vehicle's state and
 //! shape, path points and the shared local paths exchanged over V2V, a sampling grid, and the one
 //! typed error for a parameter out of range.
 //!
@@ -11,6 +12,7 @@ pub mod bounds;
 pub mod error;
 pub mod files;
 pub mod grid;
+pub mod lanes;
 pub mod path;
 pub mod road;
 pub mod vehicle;

@@ -19,6 +19,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::bounds::Bound;
 use crate::error::InvalidParameter;
+use crate::lanes::{
+    ENDING_LANE_ID, LaneError, LaneId, LaneRoad, LaneRoadSpec, THROUGH_LANE_ID, merge_road_spec,
+};
 
 /// Which lane a vehicle starts in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -193,6 +196,28 @@ impl MergeRoad {
             [self.merge_end_x_m, self.y_lane_m()],
             [self.end_x_m, self.y_lane_m()],
         ]
+    }
+
+    /// The id of a lane in [`Self::lane_road`].
+    pub fn lane_id(lane: Lane) -> LaneId {
+        match lane {
+            Lane::Upper => THROUGH_LANE_ID,
+            Lane::Lower => ENDING_LANE_ID,
+        }
+    }
+
+    /// This road as lanes (description): the through lane and the ending lane, whose right
+    /// bound is the piecewise lower edge and which ends at `merge_end_x_m`.
+    pub fn lane_road_spec(&self) -> LaneRoadSpec {
+        merge_road_spec(self)
+    }
+
+    /// This road as a [`LaneRoad`]: the through lane, the ending lane with its (closed) end, the
+    /// divider up to `merge_end_x_m`, the outer edges (upper edge; lower edge with the taper).
+    /// Its queries give this road's figures (test `merge_road_as_lanes` in types/tests/lanes_road.rs).
+    /// Fails only for a road that [`Self::validate`] refuses.
+    pub fn lane_road(&self) -> Result<LaneRoad, LaneError> {
+        LaneRoad::new(&self.lane_road_spec())
     }
 
     /// Vertices of the upper edge as a polyline.
