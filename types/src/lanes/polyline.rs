@@ -532,6 +532,21 @@ impl Centreline {
         [self.to_world(lo), self.to_world(hi)]
     }
 
+    /// [`Self::interpolate`] and its derivative along s (per metre; 0 beyond the ends, where the
+    /// value is clamped). At a vertex, the slope of the segment that begins there.
+    pub fn interpolate_with_slope(&self, values: &[f64], s_m: f64) -> (f64, f64) {
+        let s = s_m.clamp(0.0, self.length_m());
+        let (k, t) = self.locate(s);
+        let t = t.clamp(0.0, 1.0);
+        let dv = values[k + 1] - values[k];
+        let slope = if s_m < 0.0 || s_m > self.length_m() {
+            0.0
+        } else {
+            dv / self.len_m[k]
+        };
+        (values[k] + t * dv, slope)
+    }
+
     /// Interpolates per-vertex values linearly in s (clamped to the end values beyond the ends).
     pub fn interpolate(&self, values: &[f64], s_m: f64) -> f64 {
         let s = s_m.clamp(0.0, self.length_m());
