@@ -11,8 +11,8 @@
 //!   indefinitely too).
 //! - The sign at a vertex is taken from the bisector of the two segments (the 2-D
 //!   angle-weighted pseudo-normal), so the signed distance is continuous across vertices.
-//! - Segments are grouped in blocks of [`BLOCK`] with a bounding box: the nearest box is
-//!   scanned first, then only the boxes that could hold a nearer point.
+//! - Segments are grouped in blocks of [`BLOCK`] with a bounding box: the rays are tested
+//!   first, then the nearest box, then only the boxes that could hold a nearer point.
 
 use mergesim_types::lanes::{LaneRoad, Side};
 
@@ -54,7 +54,8 @@ pub(crate) struct EdgeGeometry {
     ray_end: bool,
     /// +1 if the drivable area lies to the left of the edge's direction, −1 to its right.
     inside_sign: f64,
-    /// Per block of segments: [min, max] corners of its box (infinite for a block with a ray).
+    /// Per block of segments: [min, max] corners of the box of its vertices (a ray's finite
+    /// part only: the rays are always tested).
     boxes: Vec<[[f64; 2]; 2]>,
 }
 
@@ -133,9 +134,6 @@ impl EdgeGeometry {
                     .step_by(BLOCK)
                     .map(|b0| {
                         let b1 = (b0 + BLOCK).min(nseg);
-                        if (ray_start && b0 == 0) || (ray_end && b1 == nseg) {
-                            return [[f64::NEG_INFINITY; 2], [f64::INFINITY; 2]];
-                        }
                         let mut lo = [f64::INFINITY; 2];
                         let mut hi = [f64::NEG_INFINITY; 2];
                         for p in &pts[b0..=b1] {
@@ -208,7 +206,20 @@ impl EdgeGeometry {
                 }
             }
         };
-        // The nearest box first, then every other box that could hold a nearer point.
+        // The rays first (the boxes hold only the finite segments), then the nearest box, then
+        // every other box that could hold a nearer point.
+        for k in [
+            self.ray_start.then_some(0),
+            self.ray_end.then_some(nseg - 1),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            let (d2, foot, at) = self.segment(k, q);
+            if d2 < best.0 {
+                best = (d2, foot, at, k);
+            }
+        }
         let first = (0..self.boxes.len())
             .min_by(|&a, &b| box_d2(&self.boxes[a]).total_cmp(&box_d2(&self.boxes[b])))
             .unwrap_or(0);
