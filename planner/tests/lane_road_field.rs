@@ -385,3 +385,68 @@ fn an_ending_lane_closes_with_an_edge() {
         last = v;
     }
 }
+
+/// Two lanes on a 200 m-radius left arc whose divider moves across them (the right lane widens
+/// by 1 m over 100 m while the left one narrows): the divider term's ∂U/∂s (d_div'(s) ≠ 0) is
+/// mapped through the frame too.
+#[test]
+fn a_moving_divider_has_its_along_lane_gradient() {
+    use mergesim_types::lanes::{LaneId, LaneSpec};
+    let (r_right, w) = (200.0, 3.5);
+    let n = 100;
+    let arc = |radius: f64| -> Vec<[f64; 2]> {
+        (0..=n)
+            .map(|k| {
+                let phi = k as f64 / r_right;
+                [radius * phi.sin(), r_right - radius * phi.cos()]
+            })
+            .collect()
+    };
+    let shift: Vec<f64> = (0..=n).map(|k| k as f64 / n as f64).collect();
+    let right = LaneSpec {
+        left: Some(LaneId(1)),
+        width_m: Vec::new(),
+        left_width_m: shift.iter().map(|t| 0.5 * w + t).collect(),
+        right_width_m: vec![0.5 * w],
+        ..LaneSpec::new(LaneId(2), arc(r_right), w)
+    };
+    let left = LaneSpec {
+        right: Some(LaneId(2)),
+        width_m: Vec::new(),
+        left_width_m: vec![0.5 * w],
+        right_width_m: shift.iter().map(|t| 0.5 * w - t).collect(),
+        ..LaneSpec::new(LaneId(1), arc(r_right - w), w)
+    };
+    let road = LaneRoad::new(&LaneRoadSpec {
+        lanes: vec![left, right],
+        tolerances: Default::default(),
+    })
+    .unwrap();
+    let geometry = LaneRoadGeometry::new(&road);
+    assert_eq!(geometry.divider_count(), 1);
+    let p = PlannerParams::default();
+    let field = LaneRoadField::new(&geometry, &p, half_width_m());
+    // The ridge follows the divider: its along-lane gradient is the ∂U/∂s term.
+    let lane = road.lane(LaneId(2)).unwrap();
+    let s = 50.0;
+    let (d_div, slope) = lane.bound_d_and_slope(mergesim_types::lanes::Side::Left, s);
+    // (s runs along 1 m arcs' chords, 2R sin(1/2R) = 1 − 1.0e-6 m: s = 50 is a hair past k = 50.)
+    assert!((d_div - (0.5 * w + 0.5)).abs() < 1e-5 && (slope - 0.01).abs() < 1e-7);
+    let q = lane.point(s, d_div - p.lane_sigma_m);
+    let g = field.lane_gradient(q[0], q[1]);
+    // Along the frame's own ∂p/∂s (∇d is orthogonal to it; the smoothed tangent differs from
+    // it by up to half a vertex's turn, enough to mix in ∂U/∂d): ∂U/∂s / |∂p/∂s|, with
+    // ∂U/∂s = U δ/σ² · d_div' = −A e^{−½}/σ · 0.01 at δ = −σ.
+    let axes = lane.centreline().axes(s, d_div - p.lane_sigma_m);
+    let norm = axes.dp_ds[0].hypot(axes.dp_ds[1]);
+    let along = (g[0] * axes.dp_ds[0] + g[1] * axes.dp_ds[1]) / norm;
+    let expected = -p.lane_amplitude * (-0.5_f64).exp() / p.lane_sigma_m * slope / norm;
+    assert!(
+        (along - expected).abs() < 1e-9 * expected.abs(),
+        "{along} vs {expected}"
+    );
+    let worst = check_gradients(&road, 2000, |r| {
+        lane.point(-10.0 + 120.0 * r.next(), -3.0 + 10.0 * r.next())
+    });
+    eprintln!("moving divider: worst relative gradient error {worst:.1e}");
+}
