@@ -7,6 +7,7 @@ use mergesim_types::lanes::{
     on_ramp_ids, on_ramp_spec,
 };
 use planner::attractive_field::AttractiveField;
+use planner::lane_frame::lane_relative_heading_rad;
 use planner::lane_road_field::{LaneAttraction, LaneRoadField, LaneRoadGeometry};
 use planner::road_field::RoadField;
 use planner::{MergeRoad, PlannerParams, VehicleShape};
@@ -340,6 +341,17 @@ fn rotated_and_shifted_road_gives_the_same_field() {
             LaneAttraction::ahead_of(b.lane(THROUGH_LANE_ID).unwrap(), &p, ego_m[0], ego_m[1]),
         );
         assert!(close(la.value(q[0], q[1]), lb.value(qm[0], qm[1]), 1e-9));
+        // Eq. 4's heading relative to the lane: the same for a vehicle turned with the map.
+        let yaw = 3.0 * rng.next() - 1.5;
+        let (ca, cb) = (
+            through.centreline(),
+            b.lane(THROUGH_LANE_ID).unwrap().centreline(),
+        );
+        let (ha, hb) = (
+            lane_relative_heading_rad(ca, q, yaw),
+            lane_relative_heading_rad(cb, qm, yaw + angle),
+        );
+        assert!((ha - hb).abs() < 1e-9, "{q:?}: {ha} vs {hb}");
     }
     eprintln!("rotated + shifted curved merge: worst relative value difference {worst:.1e}");
 }
