@@ -30,7 +30,7 @@ pub struct RoadField<'a> {
 }
 
 /// Edge term e(g) = ½ ξ / g² for g ≥ g_c, its tangent line below, and de/dg.
-fn edge_term(gain_m2: f64, clamp_m: f64, clearance_m: f64) -> (f64, f64) {
+pub(crate) fn edge_term(gain_m2: f64, clamp_m: f64, clearance_m: f64) -> (f64, f64) {
     if clearance_m >= clamp_m {
         let inv = 1.0 / clearance_m;
         (0.5 * gain_m2 * inv * inv, -gain_m2 * inv * inv * inv)

@@ -230,6 +230,17 @@ impl Lane {
         }
     }
 
+    /// Lateral offset of one bound at s and its slope d(d)/ds (m, per m; slope 0 beyond the
+    /// lane's ends, where the offset keeps its end value). For the lane-frame road terms'
+    /// ∂/∂s (Eqs. 2–3).
+    pub fn bound_d_and_slope(&self, side: Side, s_m: f64) -> (f64, f64) {
+        let offsets = match side {
+            Side::Left => &self.left_d_m,
+            Side::Right => &self.right_d_m,
+        };
+        self.centreline.interpolate_with_slope(offsets, s_m)
+    }
+
     /// Width at s (m).
     pub fn width_m(&self, s_m: f64) -> f64 {
         self.left_d_m(s_m) - self.right_d_m(s_m)

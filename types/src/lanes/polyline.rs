@@ -13,6 +13,10 @@ use super::spec::LaneId;
 /// Largest turn accepted at one centreline vertex (rad): more is a spike or a reversal.
 pub const MAX_VERTEX_TURN_RAD: f64 = FRAC_PI_2;
 
+/// Centrelines with at most this many segments are projected by solving every cell, without
+/// walking the index (its heap allocation costs more than a few exact solves).
+const LINEAR_SCAN_SEGMENTS: usize = 8;
+
 /// Slack on the segment parameter t ∈ [0, 1] when a point sits exactly on a cell's border.
 const T_SLACK: f64 = 1e-12;
 
@@ -394,22 +398,21 @@ impl Centreline {
                 },
             );
         }
-        for (seg, dist2) in self.tree.nearest_neighbor_iter_with_distance_2(q) {
-            if let Some(b) = best
-                && dist2.sqrt() > b.d_m.abs() * self.max_miter * (1.0 + 1e-12) + 1e-12
-            {
-                break;
+        if nseg <= LINEAR_SCAN_SEGMENTS {
+            // A few segments: solve every cell (no index walk, no allocation).
+            for k in 0..nseg {
+                if let Some((t, d)) = self.solve_cell(k, q) {
+                    keep(
+                        &mut best,
+                        FramePoint {
+                            s_m: self.s_m[k] + t * self.len_m[k],
+                            d_m: d,
+                        },
+                    );
+                }
             }
-            let k = seg.data;
-            if let Some((t, d)) = self.solve_cell(k, q) {
-                keep(
-                    &mut best,
-                    FramePoint {
-                        s_m: self.s_m[k] + t * self.len_m[k],
-                        d_m: d,
-                    },
-                );
-            }
+        } else {
+            self.project_indexed(q, &mut best, keep);
         }
         match best {
             Some(b) => b,
@@ -427,6 +430,33 @@ impl Centreline {
                     s_m: self.s_m[k] + t * self.len_m[k],
                     d_m: dot(w, left_of(self.dir[k])),
                 }
+            }
+        }
+    }
+
+    /// The index walk of [`Self::project`]: segments in order of distance, each solved exactly,
+    /// until no farther segment can hold a smaller |d|.
+    fn project_indexed(
+        &self,
+        q: [f64; 2],
+        best: &mut Option<FramePoint>,
+        keep: fn(&mut Option<FramePoint>, FramePoint),
+    ) {
+        for (seg, dist2) in self.tree.nearest_neighbor_iter_with_distance_2(q) {
+            if let Some(b) = *best
+                && dist2.sqrt() > b.d_m.abs() * self.max_miter * (1.0 + 1e-12) + 1e-12
+            {
+                break;
+            }
+            let k = seg.data;
+            if let Some((t, d)) = self.solve_cell(k, q) {
+                keep(
+                    best,
+                    FramePoint {
+                        s_m: self.s_m[k] + t * self.len_m[k],
+                        d_m: d,
+                    },
+                );
             }
         }
     }
@@ -530,6 +560,21 @@ impl Centreline {
             }
         }
         [self.to_world(lo), self.to_world(hi)]
+    }
+
+    /// [`Self::interpolate`] and its derivative along s (per metre; 0 beyond the ends, where the
+    /// value is clamped). At a vertex, the slope of the segment that begins there.
+    pub fn interpolate_with_slope(&self, values: &[f64], s_m: f64) -> (f64, f64) {
+        let s = s_m.clamp(0.0, self.length_m());
+        let (k, t) = self.locate(s);
+        let t = t.clamp(0.0, 1.0);
+        let dv = values[k + 1] - values[k];
+        let slope = if s_m < 0.0 || s_m > self.length_m() {
+            0.0
+        } else {
+            dv / self.len_m[k]
+        };
+        (values[k] + t * dv, slope)
     }
 
     /// Interpolates per-vertex values linearly in s (clamped to the end values beyond the ends).
