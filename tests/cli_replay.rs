@@ -117,8 +117,14 @@ fn rows_replay_by_sweep_seed_and_instance_and_by_seed_in_either_form() {
         let seed = row["seed"].as_str().unwrap();
         assert!(seed.starts_with("0x") && seed.len() == 18, "{seed}");
         // The never flags say what the nulls mean.
-        assert_eq!(row["min_ttc_never"], Value::Bool(row["min_ttc_s"].is_null()));
-        assert_eq!(row["min_gap_never"], Value::Bool(row["min_gap_m"].is_null()));
+        assert_eq!(
+            row["min_ttc_never"],
+            Value::Bool(row["min_ttc_s"].is_null())
+        );
+        assert_eq!(
+            row["min_gap_never"],
+            Value::Bool(row["min_gap_m"].is_null())
+        );
         for vehicle in row["vehicles"].as_array().unwrap() {
             assert_eq!(
                 vehicle["slowing_onset_never"],
@@ -159,7 +165,10 @@ fn rows_replay_by_sweep_seed_and_instance_and_by_seed_in_either_form() {
         );
     }
     // Different instances are different runs (the replay does pick the row's instance).
-    assert_ne!(find(3, "pf-iso")["min_gap_m"], find(2, "pf-iso")["min_gap_m"]);
+    assert_ne!(
+        find(3, "pf-iso")["min_gap_m"],
+        find(2, "pf-iso")["min_gap_m"]
+    );
 
     // By seed: the hex string of the row, and the decimal form older files wrote.
     let row = find(2, "pf-iso");
@@ -209,7 +218,10 @@ fn rows_replay_by_sweep_seed_and_instance_and_by_seed_in_either_form() {
         both_finite += u64::from(a["min_ttc_never"] == false && b["min_ttc_never"] == false);
     }
     // The scenario gives both kinds, so the counts differ and are told apart.
-    assert!(never > 0 && both_finite > 0, "never {never}, finite pairs {both_finite}");
+    assert!(
+        never > 0 && both_finite > 0,
+        "never {never}, finite pairs {both_finite}"
+    );
     assert_eq!(ttc["compared"], 4);
     assert_eq!(ttc["never"], never);
     assert_eq!(ttc["baseline_never"], baseline_never);
@@ -314,7 +326,11 @@ fn run_with_a_seed_prints_the_seed_and_every_value_it_drew() {
     assert_eq!(read_json(&json)["drawn"], row["drawn"]);
     // --quiet prints nothing; the nominal run has no `drawn`.
     let out = merge_sim(&["run", "--no-rrd", "--quiet", "--seed", seed]);
-    assert!(out.status.success() && out.stderr.is_empty(), "{}", stderr(&out));
+    assert!(
+        out.status.success() && out.stderr.is_empty(),
+        "{}",
+        stderr(&out)
+    );
     let nominal = dir.join("nominal.json");
     let out = merge_sim(&["run", "--no-rrd", "--quiet", "--json", p(&nominal)]);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -331,7 +347,10 @@ fn a_seed_that_went_through_a_double_is_refused_with_exit_2() {
         (vec!["--seed", "12.0"], "not a whole number"),
         (vec!["--seed", "0xZZ"], "not a seed"),
         (vec!["--seed", "0x10000000000000000"], "64 bits"),
-        (vec!["--seed", "3", "--sweep-seed", "1", "--instance", "2"], "cannot be used with"),
+        (
+            vec!["--seed", "3", "--sweep-seed", "1", "--instance", "2"],
+            "cannot be used with",
+        ),
         (vec!["--sweep-seed", "1"], "--instance"),
         (vec!["--instance", "1"], "--sweep-seed"),
     ] {

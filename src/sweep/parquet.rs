@@ -114,9 +114,15 @@ fn run_cells(m: Option<&RunMetrics>) -> [(&'static str, Cell); 15] {
         ("collisions", u(|m| m.collisions)),
         ("near_miss", Cell::Bool(m.map(|m| m.near_miss))),
         ("min_ttc_s", Cell::F64(m.and_then(|m| m.min_ttc_s))),
-        ("min_ttc_never", Cell::Bool(m.map(RunMetrics::min_ttc_never))),
+        (
+            "min_ttc_never",
+            Cell::Bool(m.map(RunMetrics::min_ttc_never)),
+        ),
         ("min_gap_m", Cell::F64(m.and_then(|m| m.min_gap_m))),
-        ("min_gap_never", Cell::Bool(m.map(RunMetrics::min_gap_never))),
+        (
+            "min_gap_never",
+            Cell::Bool(m.map(RunMetrics::min_gap_never)),
+        ),
         ("tet_s", f(|m| m.tet_s)),
         ("peak_yaw_rate_radps", f(|m| m.peak_yaw_rate_radps)),
         ("peak_sideslip_rad", f(|m| m.peak_sideslip_rad)),

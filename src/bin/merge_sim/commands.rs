@@ -125,11 +125,7 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
         // stderr: stdout stays the table it always was.
         eprint!(
             "{}",
-            mergesim::sweep::describe_instance(
-                &scenario,
-                seed,
-                args.sweep_seed.zip(args.instance)
-            )
+            mergesim::sweep::describe_instance(&scenario, seed, args.sweep_seed.zip(args.instance))
         );
     }
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
