@@ -152,8 +152,13 @@ pub struct VehicleFigures {
     pub peak_sideslip_rad: f64,
     /// Lowest speed (m/s).
     pub min_speed_mps: f64,
-    /// First time 0.1 m/s below its target (s).
+    /// First time 0.1 m/s below its target (s); null if it never slowed (see
+    /// `slowing_onset_never`) or the run kept no paper figures.
     pub slowing_onset_s: Option<f64>,
+    /// Whether it never slowed 0.1 m/s below its target (`slowing_onset_s` null means +∞, the
+    /// latest onset); null when the run kept no paper figures (not measured).
+    #[serde(default)]
+    pub slowing_onset_never: Option<bool>,
     /// Path length (m).
     pub path_length_m: f64,
     /// Involved in a collision.
@@ -169,7 +174,7 @@ pub struct GridRow {
     pub planner: String,
     /// Instance index (0 for the nominal scenario).
     pub instance: u64,
-    /// Seed of the instance (a string in JSON); null for the nominal scenario.
+    /// Seed of the instance (a `0x` hex string in JSON and CSV); null for the nominal scenario.
     #[serde(with = "crate::exact_seed::option")]
     pub seed: Option<u64>,
     /// Collision episodes (vehicle–vehicle and road edge); null if the run failed.
@@ -226,6 +231,7 @@ fn figures(outcome: &sim::RunOutcome) -> Vec<VehicleFigures> {
                 peak_sideslip_rad: v.max_abs_sideslip_rad,
                 min_speed_mps: v.min_speed_mps,
                 slowing_onset_s: paper.and_then(|p| p.slowing_onset_s),
+                slowing_onset_never: paper.map(|p| p.slowing_onset_s.is_none()),
                 path_length_m: v.path_length_m,
                 collided: v.collided,
             }

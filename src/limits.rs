@@ -121,7 +121,9 @@ pub fn other_limits() -> Vec<(String, String)> {
         ),
         (
             "`--seed`, sweep seeds".into(),
-            "0 to 2^64 − 1, written in JSON as strings (exact in every reader)".into(),
+            "0 to 2^64 − 1, decimal or `0x` hex; written in JSON and CSV as `0x` and 16 hex \
+             digits (exact in every reader, pandas included)"
+                .into(),
         ),
     ]
 }

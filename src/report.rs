@@ -116,7 +116,8 @@ pub fn grid_table(outcome: &GridOutcome, vehicle: &str) -> String {
     let zone = outcome.paired_differences(vehicle, GridMetric::MergeZoneRmsYawRate);
     let mut out = format!(
         "grid {} ({} set), {} instance(s) per cell, vehicle {vehicle}: mean of each planner / mean of {} \
-         (peak |r|; RMS r in the merge zone), collisions\n",
+         (peak |r|; RMS r in the merge zone), each over its n pairs (instances where both \
+         values exist) of the compared instances (both runs completed), collisions\n",
         outcome.scenario,
         outcome.params,
         outcome.runs.max(1),
@@ -128,11 +129,15 @@ pub fn grid_table(outcome: &GridOutcome, vehicle: &str) -> String {
     };
     for (p, z) in peak.iter().zip(&zone) {
         out.push_str(&format!(
-            "{:<22} {:<12} peak {:>5}  zone {:>5}  collisions {} ({} {})\n",
+            "{:<22} {:<12} peak {:>5} (n {} of {})  zone {:>5} (n {} of {})  collisions {} ({} {})\n",
             p.cell.label(),
             p.planner,
             ratio(p),
+            p.pairs,
+            p.compared,
             ratio(z),
+            z.pairs,
+            z.compared,
             p.collisions,
             p.reference,
             p.reference_collisions
@@ -157,8 +162,10 @@ pub fn study_table(outcome: &GridOutcome) -> String {
         });
     let reference = &outcome.planners[0];
     out.push_str(&format!(
-        "paired differences against {reference} (mean ± standard error; n: pairs; lower: \
-         instances where the planner's value is lower)\n"
+        "paired differences against {reference} (mean ± standard error over n: the pairs where \
+         both values exist, of `of` instances where both runs completed; never P/R: of those, \
+         the planner's / the reference's runs that never slowed (+inf, not in the means); \
+         lower: of the n pairs, those where the planner's value is lower)\n"
     ));
     for planner in &outcome.planners {
         let rows: Vec<_> = outcome
@@ -191,7 +198,7 @@ pub fn study_table(outcome: &GridOutcome) -> String {
                         .unwrap_or_else(|| "-".into())
                 };
                 out.push_str(&format!(
-                    "{vehicle:<10} {:<26} {:<12} {:>9} vs {:>9}  diff {:>9} ± {:<7} n {:>3} lower {:>3}\n",
+                    "{vehicle:<10} {:<26} {:<12} {:>9} vs {:>9}  diff {:>9} ± {:<7} n {:>3} of {:>3}{} lower {:>3}\n",
                     metric.label(),
                     d.planner,
                     fmt(d.mean),
@@ -199,6 +206,12 @@ pub fn study_table(outcome: &GridOutcome) -> String {
                     fmt(d.mean_difference),
                     fmt(d.standard_error),
                     d.pairs,
+                    d.compared,
+                    if metric == GridMetric::SlowingOnset {
+                        format!(" never P/R {}/{}", d.never, d.reference_never)
+                    } else {
+                        String::new()
+                    },
                     d.lower
                 ));
             }

@@ -16,6 +16,11 @@ pub struct RunSummary {
     /// reader; integers are read too).
     #[serde(with = "crate::exact_seed::option")]
     pub seed: Option<u64>,
+    /// The values the seed drew from the scenario's `[randomise]` ranges, by dotted name with
+    /// units (as a sweep row's `drawn`); absent for the nominal scenario. Filled by the caller
+    /// ([`RunSummary::with_drawn`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drawn: Option<std::collections::BTreeMap<String, f64>>,
     /// Simulated time (s).
     pub duration_s: f64,
     /// Wall-clock time of the simulation (s); the only field that differs between reruns.
@@ -57,6 +62,7 @@ impl RunSummary {
             params: params.name().to_string(),
             planner: planner.to_string(),
             seed,
+            drawn: None,
             duration_s: outcome.duration_s,
             wall_time_s,
             collisions: outcome.safety.collisions.len() + outcome.safety.edge_contacts.len(),
@@ -69,6 +75,15 @@ impl RunSummary {
             events: outcome.events.clone(),
             profile: outcome.profile.clone(),
         }
+    }
+
+    /// The summary with `drawn` filled from `scenario` (the scenario the run's instance was
+    /// drawn from; nothing for a run without a seed).
+    pub fn with_drawn(mut self, scenario: &scenarios::Scenario) -> Self {
+        self.drawn = self
+            .seed
+            .map(|seed| crate::sweep::drawn_values(scenario, seed));
+        self
     }
 
     /// A fixed-width table for the terminal.

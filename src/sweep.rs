@@ -45,7 +45,7 @@ use thiserror::Error;
 
 use crate::summary::RunSummary;
 pub use engine::{RunRequest, run_paired_sweep_with, validate_paired};
-pub use figures::{RunFigures, VehicleRow, drawn_values};
+pub use figures::{RunFigures, VehicleRow, describe_instance, drawn_unit, drawn_values};
 pub use merge::{merge_reports, merge_shards, merged_jsonl};
 pub use paired::{BetterWhen, PairedDifference, PairedSweepSummary, SweepReport};
 pub use rows::{JsonlRecord, RunMetrics, RunRow, RunStatus};

@@ -420,7 +420,8 @@ fn seeds_are_exact_in_every_json_reader() {
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let summary = read_json(&json);
-    assert_eq!(summary["seed"], "18446744073709551615");
+    // Written as 0x and 16 hex digits (pandas coerces strings of decimal digits to floats).
+    assert_eq!(summary["seed"], "0xffffffffffffffff");
     let row: Value = serde_json::from_str(
         std::fs::read_to_string(&jsonl)
             .unwrap()
@@ -430,7 +431,8 @@ fn seeds_are_exact_in_every_json_reader() {
     )
     .unwrap();
     let seed = row["seed"].as_str().expect("a string").to_string();
-    seed.parse::<u64>().expect("decimal digits");
+    mergesim::exact_seed::parse_seed(&seed).expect("0x and hex digits");
+    assert!(seed.starts_with("0x") && seed.len() == 18, "{seed}");
     let out = merge_sim(&[
         "run",
         "--quiet",

@@ -31,9 +31,9 @@ fn jsonl_rows(path: &Path) -> Vec<Value> {
     rows
 }
 
-/// A seed as the JSON files write it: a string of digits, exact in every reader.
+/// A seed as the JSON files write it: `0x` and 16 hex digits, exact in every reader.
 fn seed_of(row: &Value) -> u64 {
-    row["seed"].as_str().unwrap().parse().unwrap()
+    mergesim::exact_seed::parse_seed(row["seed"].as_str().unwrap()).unwrap()
 }
 
 fn p(path: &Path) -> &str {

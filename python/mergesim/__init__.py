@@ -16,7 +16,7 @@ See python/README.md.
 from ._native import ScenarioError, SimulationError, builtin_scenarios, planners
 from .env import MergeEnv, RewardWeights
 from .run import RunResult, run
-from .sweep import paired_differences, rows_frame, sweep
+from .sweep import never_as_infinity, never_column, paired_differences, rows_frame, sweep
 
 try:
     from importlib.metadata import version as _version
@@ -33,6 +33,8 @@ __all__ = [
     "ScenarioError",
     "SimulationError",
     "builtin_scenarios",
+    "never_as_infinity",
+    "never_column",
     "paired_differences",
     "planners",
     "rows_frame",

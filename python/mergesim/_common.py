@@ -50,10 +50,27 @@ def _integer(value: object) -> Optional[int]:
 
 
 def seed_arg(name: str, seed: object) -> int:
-    """A seed: an integer in 0..2**64-1 (numpy integers too, e.g. a sweep row's ``seed``)."""
+    """A seed: an integer in 0..2**64-1 (numpy integers too, e.g. a sweep row's ``seed``), or a
+    string as the result files write it (``"0x88be3e3d6d9f1a2d"``, or decimal digits). A float
+    is refused: a seed that went through a double (``9.853264649648847e18``) has lost digits and
+    would silently run another instance."""
+    if isinstance(seed, str):
+        from ._native import parse_seed
+
+        try:
+            return parse_seed(seed)
+        except ScenarioError as e:
+            raise ScenarioError(f"{name}: {e}") from None
     value = _integer(seed)
     if value is None or not 0 <= value <= _U64_MAX:
-        raise ScenarioError(f"{name} = {seed!r}: need an integer from 0 to {_U64_MAX}")
+        hint = ""
+        if isinstance(seed, float) or type(seed).__name__.startswith("float"):
+            hint = (
+                " (a float cannot be an exact seed: a seed read as a float has lost digits; "
+                "take it from the file as written, \"0x...\", or replay with sweep_seed and "
+                "instance)"
+            )
+        raise ScenarioError(f"{name} = {seed!r}: need an integer from 0 to {_U64_MAX}{hint}")
     return value
 
 

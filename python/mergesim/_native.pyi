@@ -26,6 +26,12 @@ def sweep(
 ) -> List[str]:
     """The JSONL rows of a paired sweep of the planners (none: the scenario's own)."""
 
+def instance_seed(sweep_seed: int, instance: int) -> int:
+    """The seed of instance ``instance`` of a sweep with seed ``sweep_seed``."""
+
+def parse_seed(text: str) -> int:
+    """A seed written as text (``"0x..."`` or decimal digits); raises ScenarioError otherwise."""
+
 def builtin_scenarios() -> List[str]:
     """Names of the built-in scenarios."""
 

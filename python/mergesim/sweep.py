@@ -18,23 +18,58 @@ from ._common import (
     seed_arg,
 )
 
-#: Row fields that hold a 64-bit seed, written as strings in the JSONL (exact in every reader).
+#: Row fields that hold a 64-bit seed, written as ``"0x..."`` strings in the JSONL (exact in
+#: every reader, pandas included); decimal strings of older files are read too.
 _SEED_FIELDS = ("seed", "sweep_seed")
 
-#: Run-level figures whose ``null`` in a row means +∞ (no pair ever came within range / was
-#: ever closing), as ``merge_sim sweep`` counts them in its paired differences.
-INFINITE_WHEN_NULL = ("min_gap_m", "min_ttc_s")
-#: Per-vehicle figures (``<vehicle>.<figure>``) whose ``null`` means +∞ (never slowed, never
-#: crossed the lane divider).
-VEHICLE_INFINITE_WHEN_NULL = ("slowing_onset_s", "divider_crossing_t_s")
+#: Run-level figures whose ``null`` means "never" (+∞: no pair ever came within range / was ever
+#: closing), each with the boolean column that says so.
+NEVER_FLAGS = {"min_gap_m": "min_gap_never", "min_ttc_s": "min_ttc_never"}
+#: The same for each vehicle's figures (``<vehicle>.<figure>`` → ``<vehicle>.<flag>``): never
+#: slowed, never crossed the lane divider.
+VEHICLE_NEVER_FLAGS = {
+    "slowing_onset_s": "slowing_onset_never",
+    "divider_crossing_t_s": "divider_crossing_never",
+    "divider_crossing_x_m": "divider_crossing_never",
+}
 
 
-def _infinite_when_null(column: str) -> bool:
-    if column in INFINITE_WHEN_NULL:
-        return True
-    return "." in column and not column.startswith("drawn.") and (
-        column.rsplit(".", 1)[1] in VEHICLE_INFINITE_WHEN_NULL
-    )
+def never_column(column: str) -> Optional[str]:
+    """The boolean column that says when ``column``'s missing value means "never" (+∞), e.g.
+    ``"min_ttc_never"`` for ``"min_ttc_s"`` and ``"ego.slowing_onset_never"`` for
+    ``"ego.slowing_onset_s"``; None for a figure without one."""
+    if column in NEVER_FLAGS:
+        return NEVER_FLAGS[column]
+    if "." in column and not column.startswith("drawn."):
+        vehicle, figure = column.rsplit(".", 1)
+        if figure in VEHICLE_NEVER_FLAGS:
+            return f"{vehicle}.{VEHICLE_NEVER_FLAGS[figure]}"
+    return None
+
+
+def never_as_infinity(rows: pd.DataFrame, column: str) -> pd.Series:
+    """``column`` as floats with its "never" values as +∞ (where its ``..._never`` flag is true)
+    and every other missing value (a failed run, a figure not measured) still NaN: for means,
+    quantiles or orderings that count the runs where it never happened as the best / latest
+    value rather than drop them. Works on the rows of :func:`sweep`, :func:`rows_frame`, and
+    ``pandas.read_parquet`` of ``merge_sim sweep --parquet``."""
+    if column not in rows.columns:
+        raise ScenarioError(f"column {column!r}: not a column of the rows")
+    try:
+        values = rows[column].astype(float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"column {column!r}: not a numeric column") from None
+    flag = never_column(column)
+    if flag is None or flag not in rows.columns:
+        return values
+    never = rows[flag].eq(True).fillna(False).astype(bool)
+    return values.where(~never, float("inf"))
+
+
+def _seed_value(value: Any) -> int:
+    if isinstance(value, str):
+        return int(_native.parse_seed(value))
+    return int(value)
 
 
 def _flatten(prefix: str, value: Any, out: Dict[str, Any]) -> None:
@@ -63,27 +98,22 @@ def _flatten(prefix: str, value: Any, out: Dict[str, Any]) -> None:
 def rows_frame(lines: Iterable[str]) -> pd.DataFrame:
     """The DataFrame of JSONL rows (``merge_sim sweep --jsonl``): one row per line, nested fields
     flattened as in ``merge_sim sweep --parquet`` (``drawn.<name>``, ``<vehicle>.<figure>``),
-    seeds as unsigned 64-bit integers. A ``null`` that means +∞ (``min_gap_m`` and ``min_ttc_s``
-    when no pair came within range or closed; a vehicle's ``slowing_onset_s`` and
-    ``divider_crossing_t_s`` when it never slowed or crossed) is ``inf`` in a completed run's
-    row, so means and quantiles keep those runs. Reads a ``--jsonl`` file too:
-    ``rows_frame(open(path))``."""
+    seeds (``seed``, ``sweep_seed``) as unsigned 64-bit integers. "Never" reads as in the JSONL
+    and the Parquet file: the figure NaN and its ``..._never`` column True (``min_ttc_s`` /
+    ``min_ttc_never``, ``min_gap_m`` / ``min_gap_never``, a vehicle's ``slowing_onset_s`` /
+    ``slowing_onset_never`` and ``divider_crossing_t_s`` / ``divider_crossing_never``); a NaN
+    with the flag False or missing is "not measured". pandas' ``mean()`` skips NaN: use
+    :func:`never_as_infinity` to count the never runs as +∞ instead. Reads a ``--jsonl`` file
+    too: ``rows_frame(open(path))``."""
     records: List[Dict[str, Any]] = []
     for line in lines:
         flat: Dict[str, Any] = {}
         _flatten("", json.loads(line), flat)
         records.append(flat)
     frame = pd.DataFrame.from_records(records)
-    completed = frame["status"] == "completed" if "status" in frame.columns else None
-    for column in frame.columns:
-        if completed is not None and _infinite_when_null(column):
-            # +inf, not NaN: pandas would leave NaN out of means and quantiles, i.e. drop the
-            # safest runs. Only completed runs (a failed run has no figures at all).
-            values = frame[column].astype(float)
-            frame[column] = values.where(~(values.isna() & completed), float("inf"))
     for field in _SEED_FIELDS:
         if field in frame.columns:
-            frame[field] = frame[field].map(int).astype("uint64")
+            frame[field] = frame[field].map(_seed_value).astype("uint64")
     return frame
 
 
@@ -100,8 +130,9 @@ def sweep(
 
     Instance ``i`` runs with seed ``instance_seed(seed, i)`` for every planner, so the planners
     meet the same drawn scenarios and the rows are paired by ``instance`` (and ``seed``); any
-    row replays alone with ``mergesim.run(scenario, planner, seed=row.seed)``. The results do
-    not depend on ``threads``.
+    row replays alone with ``mergesim.run(scenario, planner, seed=row.seed)`` or
+    ``mergesim.run(scenario, planner, sweep_seed=row.sweep_seed, instance=row.instance)``.
+    The results do not depend on ``threads``.
 
     Args:
         scenario: A built-in name, a path, or TOML text (as in :func:`mergesim.run`).
@@ -109,7 +140,7 @@ def sweep(
             a comma-separated string (as ``--planners``); None (or an empty list) runs the
             scenario's own planners once.
         runs: Instances per planner (1 to 1,000,000).
-        seed: The sweep seed K (0 to 2**64-1).
+        seed: The sweep seed K (0 to 2**64-1; a ``"0x..."`` string too).
         threads: Worker threads (None: one per core).
         params: Overrides merged over the scenario (as in :func:`mergesim.run`).
 
@@ -118,8 +149,10 @@ def sweep(
         given order, with the fields of ``merge_sim sweep --jsonl`` rows: scenario,
         scenario_fingerprint, params, planners (the sweep's, a tuple), sweep_seed, total_runs,
         instance, planner, seed, status, error (only if a run failed), ``drawn.<value>`` (what
-        the instance drew), the run's figures (collisions, near_miss, min_ttc_s, min_gap_m,
-        tet_s, peak_yaw_rate_radps, ...), ``<vehicle>.<figure>`` and wall_time_s.
+        the instance drew), the run's figures (collisions, near_miss, min_ttc_s,
+        min_ttc_never, min_gap_m, min_gap_never, tet_s, peak_yaw_rate_radps, ...),
+        ``<vehicle>.<figure>`` and wall_time_s. "Never" is NaN with its ``..._never`` flag
+        True, as in the JSONL and the Parquet file (see :func:`rows_frame`).
 
     Raises:
         ScenarioError: Bad input (scenario, planner, runs, seed or threads).
@@ -149,10 +182,11 @@ def paired_differences(
     rows: pd.DataFrame, metric: str, baseline: str, other: str
 ) -> pd.Series:
     """``other − baseline`` of ``metric`` per instance, over the instances both completed (and,
-    for a ``<vehicle>.<figure>``, where both have a value).
+    for a ``<vehicle>.<figure>``, where both have a value or a "never").
 
-    A figure that is +∞ in both rows (e.g. ``min_ttc_s`` when no pair ever closed with either
-    planner) gives 0 (a tie, as ``merge_sim sweep`` counts it); +∞ in one gives ±∞. So
+    "Never" counts as +∞ (:func:`never_as_infinity`). A figure that is never in both rows (e.g.
+    ``min_ttc_s`` when no pair ever closed with either planner) gives 0 (a tie, as
+    ``merge_sim sweep`` counts it); never in one gives ±∞. So
     ``(d > 0).sum()``, ``(d < 0).sum()`` and ``(d == 0).sum()`` are the CLI's higher / lower /
     tied counts, and the CLI's mean difference ± SE is that of the finite differences.
 
@@ -167,7 +201,8 @@ def paired_differences(
     """
     if metric not in rows.columns:
         raise ScenarioError(f"metric {metric!r}: not a column of the rows")
-    done = rows[rows["status"] == "completed"]
+    values = never_as_infinity(rows, metric)
+    done = rows.assign(**{metric: values})[rows["status"] == "completed"]
     table = done.pivot(index="instance", columns="planner", values=metric)
     for name in (baseline, other):
         if name not in table.columns:

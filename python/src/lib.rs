@@ -22,6 +22,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_scenarios, m)?)?;
     m.add_function(wrap_pyfunction!(planners, m)?)?;
+    m.add_function(wrap_pyfunction!(instance_seed, m)?)?;
+    m.add_function(wrap_pyfunction!(parse_seed, m)?)?;
     m.add_class::<env_core::EnvCore>()?;
     Ok(())
 }
@@ -36,4 +38,17 @@ fn builtin_scenarios() -> Vec<&'static str> {
 #[pyfunction]
 fn planners() -> Vec<&'static str> {
     planner::PlannerKind::ALL.iter().map(|k| k.name()).collect()
+}
+
+/// The seed of instance `instance` of a sweep with seed `sweep_seed` (what the sweep ran it with).
+#[pyfunction]
+fn instance_seed(sweep_seed: u64, instance: u64) -> u64 {
+    mergesim::sweep::instance_seed(sweep_seed, instance)
+}
+
+/// A seed written as text: `0x` and hex digits (what the result files write) or decimal digits;
+/// anything else (a float such as `9.853264649648847e18`) raises `ScenarioError`.
+#[pyfunction]
+fn parse_seed(text: &str) -> PyResult<u64> {
+    mergesim::exact_seed::parse_seed(text).map_err(|e| errors::BindingError::input(&e).into())
 }

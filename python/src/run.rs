@@ -41,7 +41,8 @@ pub fn run(
         RunError::Setup(e) => BindingError::input(&e),
         RunError::Run(e) => BindingError::run(&e),
     })?;
-    let summary = serde_json::to_string(&finished.summary)
+    let summary = finished.summary.with_drawn(&scenario);
+    let summary = serde_json::to_string(&summary)
         .map_err(|e| BindingError::Run(format!("cannot encode the summary: {e}")))?;
     Ok((summary, time_series_csv(&finished.outcome.time_series)))
 }

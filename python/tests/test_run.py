@@ -32,6 +32,9 @@ def test_run_matches_the_cli(merge_sim: str, short_urgent_merge: pathlib.Path, t
     )
     result = mergesim.run(short_urgent_merge, planner="pf-sp", seed=7)
     assert without_wall_time(result.summary) == without_wall_time(json.loads(json_path.read_text()))
+    # The seed as the files write it, and the values it drew (as a sweep row's `drawn`).
+    assert result.summary["seed"] == "0x0000000000000007"
+    assert result.summary["drawn"]["sim.mu"] > 0 and "vehicles.ego.speed_mps" in result.summary["drawn"]
     pd.testing.assert_frame_equal(result.time_series, pd.read_csv(csv_path))
 
 

@@ -78,12 +78,15 @@ def test_paired_differences(rows: pd.DataFrame) -> None:
         mergesim.paired_differences(rows, "min_speed_mps", "pf-cs", "pf-sp")
 
 
-def test_never_is_infinite_and_tied(rows: pd.DataFrame) -> None:
-    """null = +inf (no pair ever closing): kept in the rows as inf, both inf = a tie, as the CLI
-    counts it; NaN would drop the safest runs from means and from the paired differences."""
-    assert rows["min_ttc_s"].notna().all()
-    never = rows["min_ttc_s"] == float("inf")
+def test_never_is_flagged_and_tied(rows: pd.DataFrame) -> None:
+    """null = never (no pair ever closing): NaN in the rows with ``min_ttc_never`` True, as in
+    the JSONL and the Parquet file; counted as +inf by never_as_infinity and in the paired
+    differences, both never = a tie, as the CLI counts it."""
+    never = rows["min_ttc_never"]
+    assert never.dtype == bool
     assert never.any(), "expected some run without a closing pair in 2 s of urgent_merge"
+    assert list(rows["min_ttc_s"].isna()) == list(never)
+    assert list(mergesim.never_as_infinity(rows, "min_ttc_s") == float("inf")) == list(never)
     diff = mergesim.paired_differences(rows, "min_ttc_s", "pf-cs", "pf-iso")
     assert list(diff.index) == [0, 1, 2]
     both_never = rows[never].groupby("instance").size() == 2

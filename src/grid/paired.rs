@@ -20,7 +20,8 @@ pub enum GridMetric {
     PeakSideslip,
     /// Lowest speed (m/s).
     MinSpeed,
-    /// First time 0.1 m/s below the target (s); pairs only where both slowed.
+    /// First time 0.1 m/s below the target (s); the means are over the pairs where both
+    /// slowed, the runs that never slowed are counted in `never` / `reference_never`.
     SlowingOnset,
     /// Path length (m).
     PathLength,
@@ -86,8 +87,19 @@ pub struct PairedDifference {
     pub reference: String,
     /// The metric.
     pub metric: GridMetric,
-    /// Instances where both runs completed.
+    /// Instances where both runs completed with the vehicle.
+    #[serde(default)]
+    pub compared: u64,
+    /// Of those, instances where both values exist: the means, the mean difference and `lower`
+    /// are over these (the `n` of the tables).
     pub pairs: u64,
+    /// Of the compared instances, those where the planner's vehicle never slowed (slowing
+    /// onset only: +∞, left out of the means; 0 for the other metrics).
+    #[serde(default)]
+    pub never: u64,
+    /// The same for the reference planner.
+    #[serde(default)]
+    pub reference_never: u64,
     /// Mean of the planner's metric.
     pub mean: Option<f64>,
     /// Mean of the reference's metric.
@@ -110,11 +122,12 @@ impl GridOutcome {
         let Some(reference) = self.planners.first() else {
             return Vec::new();
         };
-        let value = |row: &GridRow| {
-            row.vehicles
-                .iter()
-                .find(|v| v.vehicle == vehicle)
-                .and_then(|v| metric.of(v))
+        fn of_vehicle<'a>(row: &'a GridRow, vehicle: &str) -> Option<&'a VehicleFigures> {
+            row.vehicles.iter().find(|v| v.vehicle == vehicle)
+        }
+        let value = |row: &GridRow| of_vehicle(row, vehicle).and_then(|v| metric.of(v));
+        let never = |v: &VehicleFigures| {
+            metric == GridMetric::SlowingOnset && v.slowing_onset_never == Some(true)
         };
         let mut out = Vec::new();
         for cell in self.axes.cells() {
@@ -124,10 +137,19 @@ impl GridOutcome {
                 let mut diffs = Vec::new();
                 let mut reference_values = Vec::new();
                 let mut lower = 0;
+                let (mut compared, mut never_count, mut reference_never) = (0, 0, 0);
                 for row in in_cell.iter().filter(|r| &r.planner == planner) {
                     let other = in_cell
                         .iter()
                         .find(|r| &r.planner == reference && r.instance == row.instance);
+                    if let (Some(a), Some(b)) = (
+                        of_vehicle(row, vehicle),
+                        other.and_then(|r| of_vehicle(r, vehicle)),
+                    ) {
+                        compared += 1;
+                        never_count += u64::from(never(a));
+                        reference_never += u64::from(never(b));
+                    }
                     if let (Some(a), Some(b)) = (value(row), other.and_then(|r| value(r))) {
                         values.push(a);
                         reference_values.push(b);
@@ -149,7 +171,10 @@ impl GridOutcome {
                     planner: planner.clone(),
                     reference: reference.clone(),
                     metric,
+                    compared,
                     pairs: diffs.len() as u64,
+                    never: never_count,
+                    reference_never,
                     mean: mean(&values),
                     reference_mean: mean(&reference_values),
                     mean_difference: mean(&diffs),
@@ -169,7 +194,8 @@ impl GridOutcome {
             "predict_obstacles_in_path,substeps,path_time_gap_s,interaction_time_gap_s,planner,\
              instance,seed,collisions,error,vehicle,peak_yaw_rate_radps,\
              merge_zone_rms_yaw_rate_radps,outside_merge_zone_rms_yaw_rate_radps,\
-             peak_sideslip_rad,min_speed_mps,slowing_onset_s,path_length_m,collided\n",
+             peak_sideslip_rad,min_speed_mps,slowing_onset_s,slowing_onset_never,path_length_m,\
+             collided\n",
         );
         let opt = |v: Option<f64>| v.map(|x| format!("{x}")).unwrap_or_default();
         for row in &self.rows {
@@ -182,7 +208,9 @@ impl GridOutcome {
                 c.interaction_time_gap_s,
                 row.planner,
                 row.instance,
-                row.seed.map(|s| s.to_string()).unwrap_or_default(),
+                row.seed
+                    .map(crate::exact_seed::format_seed)
+                    .unwrap_or_default(),
                 row.collisions.map(|n| n.to_string()).unwrap_or_default(),
                 row.error
                     .as_deref()
@@ -190,11 +218,11 @@ impl GridOutcome {
                     .unwrap_or_default(),
             );
             if row.vehicles.is_empty() {
-                text.push_str(&format!("{head},,,,,,,,,\n"));
+                text.push_str(&format!("{head},,,,,,,,,,\n"));
             }
             for v in &row.vehicles {
                 text.push_str(&format!(
-                    "{head},{},{},{},{},{},{},{},{},{}\n",
+                    "{head},{},{},{},{},{},{},{},{},{},{}\n",
                     v.vehicle,
                     v.peak_yaw_rate_radps,
                     opt(v.merge_zone_rms_yaw_rate_radps),
@@ -202,6 +230,9 @@ impl GridOutcome {
                     v.peak_sideslip_rad,
                     v.min_speed_mps,
                     opt(v.slowing_onset_s),
+                    v.slowing_onset_never
+                        .map(|b| b.to_string())
+                        .unwrap_or_default(),
                     v.path_length_m,
                     v.collided
                 ));

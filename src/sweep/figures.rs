@@ -48,6 +48,53 @@ pub fn drawn_values(scenario: &Scenario, seed: u64) -> BTreeMap<String, f64> {
     drawn
 }
 
+/// The unit of a drawn value, read off its name (names carry their unit): `m/s` for `_mps`,
+/// `m` for `_m`, `s` for `_s`, nothing for `mu` and `drop_probability` (dimensionless).
+pub fn drawn_unit(name: &str) -> &'static str {
+    if name.ends_with("_mps") {
+        "m/s"
+    } else if name.ends_with("_m") {
+        "m"
+    } else if name.ends_with("_s") {
+        "s"
+    } else {
+        ""
+    }
+}
+
+/// What `merge_sim run --seed` prints on stderr before the run: the seed (as the result files
+/// write it, with the sweep and instance it replays when given) and every value it drew, one
+/// `name = value unit` a line, the value printed exactly (shortest round-trip form).
+pub fn describe_instance(scenario: &Scenario, seed: u64, sweep: Option<(u64, u64)>) -> String {
+    let seed_text = crate::exact_seed::format_seed(seed);
+    let mut out = match sweep {
+        Some((sweep_seed, instance)) => format!(
+            "seed {seed_text} (= {seed}; instance {instance} of sweep seed {})",
+            crate::exact_seed::format_seed(sweep_seed)
+        ),
+        None => format!("seed {seed_text} (= {seed})"),
+    };
+    let drawn = drawn_values(scenario, seed);
+    if drawn.is_empty() {
+        out.push_str(&format!(
+            ": scenario {} randomises nothing (the seed only seeds the V2V drops)\n",
+            scenario.name
+        ));
+        return out;
+    }
+    out.push_str(&format!(" drew {} values:\n", drawn.len()));
+    for (name, value) in &drawn {
+        let unit = drawn_unit(name);
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        out.push_str(&format!("  {name} = {value}{unit}\n"));
+    }
+    out
+}
+
 /// The figures of one vehicle in one run (from `RunSummary.vehicles`, flat: the paper's
 /// figures are `null` when the run kept none).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -110,6 +157,20 @@ pub struct VehicleRow {
 }
 
 impl VehicleRow {
+    /// Whether the vehicle never slowed 0.1 m/s below its target (`slowing_onset_s` is `None`:
+    /// +∞, the latest onset); `None` when the run kept no paper figures (not measured).
+    pub fn slowing_onset_never(&self) -> Option<bool> {
+        self.max_abs_lane_offset_m
+            .map(|_| self.slowing_onset_s.is_none())
+    }
+
+    /// Whether the vehicle never crossed the lane divider (`divider_crossing_t_s` and `_x_m`
+    /// are `None`: +∞); `None` when the run kept no paper figures (not measured).
+    pub fn divider_crossing_never(&self) -> Option<bool> {
+        self.max_abs_lane_offset_m
+            .map(|_| self.divider_crossing_t_s.is_none())
+    }
+
     /// The row of one vehicle's summary.
     pub fn of(v: &sim::metrics::VehicleMetricsSummary) -> Self {
         let paper = v.paper_metrics.as_ref();

@@ -8,7 +8,9 @@
 //! +∞ in the better / worse / tied counts; one that is `null` because it is undefined (the
 //! yaw-rate RMS of a zone never entered) leaves the instance out. The mean, the mean difference
 //! P − B and its standard error (sample standard deviation / √n) are over the instances where
-//! both values are finite (`pairs`).
+//! both values are finite (`pairs`, the `n` of the table); `compared` counts every instance in
+//! the better / worse / tied counts, and `never` / `baseline_never` how many of those had the
+//! +∞ ("never") value, so an instance that is in `compared` but not in `pairs` is accounted for.
 
 use std::collections::BTreeMap;
 
@@ -139,8 +141,16 @@ pub struct PairedDifference {
     pub better_when: Option<BetterWhen>,
     /// Instances compared (both runs completed, the figure defined for both).
     pub compared: u64,
-    /// Of those, instances where both values are finite: the means are over these.
+    /// Of those, instances where both values are finite: the means are over these (the `n` of
+    /// the table).
     pub pairs: u64,
+    /// Of the compared instances, those where the planner's value is "never" (+∞: no closing
+    /// pair, no pair in range, never slowed, never crossed); 0 for figures without one.
+    #[serde(default)]
+    pub never: u64,
+    /// The same for the baseline.
+    #[serde(default)]
+    pub baseline_never: u64,
     /// Mean of the planner's values.
     pub mean: Option<f64>,
     /// Mean of the baseline's values.
@@ -174,6 +184,7 @@ fn compare<T>(
         (None, WhenNull::Skip) => None,
     };
     let (mut lower, mut higher, mut tied, mut compared) = (0, 0, 0, 0);
+    let (mut never, mut baseline_never) = (0, 0);
     let (mut values, mut baseline_values, mut differences) = (Vec::new(), Vec::new(), Vec::new());
     for (mine, theirs) in pairs {
         let (Some(a), Some(b)) = (
@@ -189,6 +200,8 @@ fn compare<T>(
             None => continue,
         }
         compared += 1;
+        never += u64::from(a == f64::INFINITY);
+        baseline_never += u64::from(b == f64::INFINITY);
         if a.is_finite() && b.is_finite() {
             values.push(a);
             baseline_values.push(b);
@@ -208,6 +221,8 @@ fn compare<T>(
         better_when: figure.better_when,
         compared,
         pairs: differences.len() as u64,
+        never,
+        baseline_never,
         mean: mean(&values),
         baseline_mean: mean(&baseline_values),
         mean_difference: mean(&differences),
@@ -330,13 +345,18 @@ impl PairedSweepSummary {
         let opt = |v: Option<f64>| v.map_or_else(|| "-".into(), |x| format!("{x:.4}"));
         let count = |v: Option<u64>| v.map_or_else(|| "-".into(), |n| n.to_string());
         let mut out = format!(
-            "paired differences against the baseline {} (instances where both completed; \
-             better / worse / tied per instance; null = +inf for min gap, min TTC, onset, \
-             crossing):\n{:<8} {:<9} {:<38} {:>4} {:>11} {:>11} {:>20} {:>6} {:>6} {:>5} {:>7} {:>7}\n",
+            "paired differences against the baseline {}: compared = instances where both \
+             completed (better / worse / tied are over these; never = +inf: min gap, min TTC, \
+             onset, crossing); never P/B = of those, the planner's / the baseline's runs with \
+             the never value; n = pairs with both values finite: the means and the mean \
+             difference are over these n only\n{:<8} {:<9} {:<38} {:>8} {:>9} {:>4} {:>11} \
+             {:>11} {:>20} {:>6} {:>6} {:>5} {:>7} {:>7}\n",
             self.planners.first().map_or("-", String::as_str),
             "planner",
             "vehicle",
             "metric",
+            "compared",
+            "never P/B",
             "n",
             "baseline",
             "planner",
@@ -354,11 +374,13 @@ impl PairedSweepSummary {
                 _ => "-".into(),
             };
             out.push_str(&format!(
-                "{:<8} {:<9} {:<38} {:>4} {:>11} {:>11} {:>20} {:>6} {:>6} {:>5} {:>7} {:>7}\n",
+                "{:<8} {:<9} {:<38} {:>8} {:>9} {:>4} {:>11} {:>11} {:>20} {:>6} {:>6} {:>5} {:>7} {:>7}\n",
                 d.planner,
                 d.vehicle.as_deref().unwrap_or("(run)"),
                 d.metric,
                 d.compared,
+                format!("{}/{}", d.never, d.baseline_never),
+                d.pairs,
                 opt(d.baseline_mean),
                 opt(d.mean),
                 difference,

@@ -456,7 +456,7 @@ fn the_parquet_file_holds_exactly_the_rows_of_the_jsonl() {
     let identity: serde_json::Value =
         serde_json::from_str(&metadata[parquet::METADATA_KEY]).unwrap();
     assert_eq!(identity["planners"], serde_json::json!(["pf-cs", "pf-iso"]));
-    assert_eq!(identity["sweep_seed"], "91");
+    assert_eq!(identity["sweep_seed"], "0x000000000000005b");
     // Every column against the JSON of the rows, looked up by the column's name.
     let json: Vec<serde_json::Value> = rows
         .iter()
@@ -482,8 +482,12 @@ fn the_parquet_file_holds_exactly_the_rows_of_the_jsonl() {
                     .find(|v| v["name"] == vehicle)
                     .map(|v| v[figure].clone())
                     .unwrap_or(serde_json::Value::Null)
+            } else if name == "sweep_seed" {
+                serde_json::json!(91)
             } else if name == "seed" {
-                serde_json::json!(row["seed"].as_str().unwrap().parse::<u64>().unwrap())
+                serde_json::json!(
+                    crate::exact_seed::parse_seed(row["seed"].as_str().unwrap()).unwrap()
+                )
             } else {
                 row.get(name.as_str())
                     .cloned()
@@ -505,7 +509,7 @@ fn the_parquet_file_holds_exactly_the_rows_of_the_jsonl() {
             assert_eq!(found, expected, "column {name}, row {i}");
         }
     }
-    assert_eq!(vehicle_columns, 2 * 26 * rows.len());
+    assert_eq!(vehicle_columns, 2 * 28 * rows.len());
     // Every run-level figure and every vehicle figure of the JSON is a column.
     for key in json[0].as_object().unwrap().keys() {
         if !["drawn", "vehicles"].contains(&key.as_str()) {
@@ -526,8 +530,8 @@ fn the_parquet_file_holds_exactly_the_rows_of_the_jsonl() {
         .report();
     let meta = BTreeMap::new();
     assert_eq!(
-        parquet::parquet_bytes(&again.rows(), &meta).unwrap(),
-        parquet::parquet_bytes(&report.rows(), &meta).unwrap()
+        parquet::parquet_bytes(&again.rows(), 91, &meta).unwrap(),
+        parquet::parquet_bytes(&report.rows(), 91, &meta).unwrap()
     );
 }
 

@@ -1,15 +1,19 @@
 //! The rows of a sweep as one Parquet file (`merge_sim sweep --parquet`), flat for pandas:
 //! one row per (instance, planner), in (instance, planner) order, with the columns
 //!
-//! - `instance` (uint64), `planner` (string), `seed` (uint64: exact, unlike JSON numbers;
-//!   the JSON files write it as a string), `status` (`completed`, `diverged`, `panicked`),
+//! - `sweep_seed` (uint64), `instance` (uint64): `merge_sim run --sweep-seed K --instance I`
+//!   replays the row; `planner` (string), `seed` (uint64: exact, unlike JSON numbers; the
+//!   JSON files write it as a `0x` hex string), `status` (`completed`, `diverged`, `panicked`),
 //!   `error` (string, null unless failed);
-//! - every run-level figure of the JSONL rows (`collisions`, `near_miss`, `min_ttc_s`, ...),
-//!   null for a failed run;
+//! - every run-level figure of the JSONL rows (`collisions`, `near_miss`, `min_ttc_s`,
+//!   `min_ttc_never`, ...), null for a failed run;
 //! - `drawn.<name>` (float64): the values the scenario drew (`drawn.sim.mu`,
 //!   `drawn.vehicles.obstacle.speed_mps`, ...);
-//! - `<vehicle>.<figure>` per vehicle (`ego.min_speed_mps`, `obstacle.slowing_onset_s`, ...),
-//!   null for a failed run.
+//! - `<vehicle>.<figure>` per vehicle (`ego.min_speed_mps`, `obstacle.slowing_onset_s`,
+//!   `obstacle.slowing_onset_never`, ...), null for a failed run.
+//!
+//! "Never" is represented as in the JSONL: the figure null (NaN in pandas) and its boolean
+//! `..._never` column true, so a null with `..._never` false or null is "not measured".
 //!
 //! The sweep's identity (scenario, fingerprint, parameter set, planners, seed, runs) is in the
 //! file's key-value metadata under `mergesim.sweep` (JSON). No wall times: the file of a sweep
@@ -103,14 +107,22 @@ impl Column {
 }
 
 /// The run-level figures of a row (nulls of the same types for a failed run).
-fn run_cells(m: Option<&RunMetrics>) -> [(&'static str, Cell); 13] {
+fn run_cells(m: Option<&RunMetrics>) -> [(&'static str, Cell); 15] {
     let u = |f: fn(&RunMetrics) -> u64| Cell::U64(m.map(f));
     let f = |f: fn(&RunMetrics) -> f64| Cell::F64(m.map(f));
     [
         ("collisions", u(|m| m.collisions)),
         ("near_miss", Cell::Bool(m.map(|m| m.near_miss))),
         ("min_ttc_s", Cell::F64(m.and_then(|m| m.min_ttc_s))),
+        (
+            "min_ttc_never",
+            Cell::Bool(m.map(RunMetrics::min_ttc_never)),
+        ),
         ("min_gap_m", Cell::F64(m.and_then(|m| m.min_gap_m))),
+        (
+            "min_gap_never",
+            Cell::Bool(m.map(RunMetrics::min_gap_never)),
+        ),
         ("tet_s", f(|m| m.tet_s)),
         ("peak_yaw_rate_radps", f(|m| m.peak_yaw_rate_radps)),
         ("peak_sideslip_rad", f(|m| m.peak_sideslip_rad)),
@@ -124,7 +136,7 @@ fn run_cells(m: Option<&RunMetrics>) -> [(&'static str, Cell); 13] {
 }
 
 /// A vehicle's figures (nulls of the same types when the row has no such vehicle).
-fn vehicle_cells(v: Option<&VehicleRow>) -> [(&'static str, Cell); 26] {
+fn vehicle_cells(v: Option<&VehicleRow>) -> [(&'static str, Cell); 28] {
     let f = |f: fn(&VehicleRow) -> f64| Cell::F64(v.map(f));
     let o = |f: fn(&VehicleRow) -> Option<f64>| Cell::F64(v.and_then(f));
     [
@@ -158,6 +170,10 @@ fn vehicle_cells(v: Option<&VehicleRow>) -> [(&'static str, Cell); 26] {
         ("rms_jerk_lat_mps3", f(|v| v.rms_jerk_lat_mps3)),
         ("slowing_onset_s", o(|v| v.slowing_onset_s)),
         (
+            "slowing_onset_never",
+            Cell::Bool(v.and_then(VehicleRow::slowing_onset_never)),
+        ),
+        (
             "merge_zone_rms_yaw_rate_radps",
             o(|v| v.merge_zone_rms_yaw_rate_radps),
         ),
@@ -168,6 +184,10 @@ fn vehicle_cells(v: Option<&VehicleRow>) -> [(&'static str, Cell); 26] {
         ("max_abs_lane_offset_m", o(|v| v.max_abs_lane_offset_m)),
         ("divider_crossing_t_s", o(|v| v.divider_crossing_t_s)),
         ("divider_crossing_x_m", o(|v| v.divider_crossing_x_m)),
+        (
+            "divider_crossing_never",
+            Cell::Bool(v.and_then(VehicleRow::divider_crossing_never)),
+        ),
         (
             "divider_crossings",
             Cell::U64(v.and_then(|v| v.divider_crossings)),
@@ -183,8 +203,9 @@ fn status_name(status: RunStatus) -> &'static str {
     }
 }
 
-/// The rows as one Arrow record batch (the columns of the module doc).
-pub fn record_batch(rows: &[&RunRow]) -> Result<RecordBatch, ParquetOutputError> {
+/// The rows of the sweep with seed `sweep_seed` as one Arrow record batch (the columns of the
+/// module doc).
+pub fn record_batch(rows: &[&RunRow], sweep_seed: u64) -> Result<RecordBatch, ParquetOutputError> {
     let mut drawn_names: Vec<&str> = rows
         .iter()
         .flat_map(|r| r.drawn.keys().map(String::as_str))
@@ -200,6 +221,7 @@ pub fn record_batch(rows: &[&RunRow]) -> Result<RecordBatch, ParquetOutputError>
         }
     }
     let mut columns: Vec<(String, bool, Column)> = vec![
+        ("sweep_seed".into(), false, Column::U64(Vec::new())),
         ("instance".into(), false, Column::U64(Vec::new())),
         ("planner".into(), false, Column::Text(Vec::new())),
         ("seed".into(), false, Column::U64(Vec::new())),
@@ -225,6 +247,7 @@ pub fn record_batch(rows: &[&RunRow]) -> Result<RecordBatch, ParquetOutputError>
     }
     for row in rows {
         let mut cells: Vec<Cell> = vec![
+            Cell::U64(Some(sweep_seed)),
             Cell::U64(Some(row.instance)),
             Cell::Bool(None),
             Cell::U64(Some(row.seed)),
@@ -264,13 +287,15 @@ pub fn record_batch(rows: &[&RunRow]) -> Result<RecordBatch, ParquetOutputError>
     Ok(RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays)?)
 }
 
-/// The Parquet bytes of `rows` (Snappy-compressed), with `metadata` on the Arrow schema (which
-/// pyarrow reads back as `table.schema.metadata`) and in the file's key-value metadata.
+/// The Parquet bytes of `rows` of the sweep with seed `sweep_seed` (Snappy-compressed), with
+/// `metadata` on the Arrow schema (which pyarrow reads back as `table.schema.metadata`) and in
+/// the file's key-value metadata.
 pub fn parquet_bytes(
     rows: &[&RunRow],
+    sweep_seed: u64,
     metadata: &BTreeMap<String, String>,
 ) -> Result<Vec<u8>, ParquetOutputError> {
-    let batch = record_batch(rows)?;
+    let batch = record_batch(rows, sweep_seed)?;
     let schema = Arc::new(
         batch
             .schema()
@@ -303,7 +328,7 @@ fn identity_metadata(report: &SweepReport) -> BTreeMap<String, String> {
             "scenario_fingerprint": s.scenario_fingerprint,
             "params": s.params,
             "planners": report.planners(),
-            "sweep_seed": s.seed.to_string(),
+            "sweep_seed": crate::exact_seed::format_seed(s.seed),
             "total_runs": s.total_runs,
             "shard": s.shard.to_string(),
         })
@@ -316,7 +341,8 @@ fn identity_metadata(report: &SweepReport) -> BTreeMap<String, String> {
 /// Writes the rows of `report` to `path` as Parquet: to a temporary file in the same folder,
 /// then renamed, so a failure never leaves half a file.
 pub fn write_parquet(path: &Path, report: &SweepReport) -> Result<(), ParquetOutputError> {
-    let bytes = parquet_bytes(&report.rows(), &identity_metadata(report))?;
+    let sweep_seed = report.summaries().first().map_or(0, |s| s.seed);
+    let bytes = parquet_bytes(&report.rows(), sweep_seed, &identity_metadata(report))?;
     crate::output::write_atomically(path, &bytes).map_err(|source| ParquetOutputError::Io {
         path: path.display().to_string(),
         source,

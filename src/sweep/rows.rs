@@ -84,35 +84,123 @@ impl RunMetrics {
     }
 }
 
+impl RunMetrics {
+    /// Whether no pair was ever closing within the TTC horizon (`min_ttc_s` is `None`): the
+    /// best value, +∞, not a missing one. Written beside `min_ttc_s` as `min_ttc_never`.
+    pub fn min_ttc_never(&self) -> bool {
+        self.min_ttc_s.is_none()
+    }
+
+    /// Whether no two bodies ever came within `[sim.safety] pair_range_m` (or the scenario has
+    /// one vehicle): `min_gap_m` is `None`, meaning +∞. Written as `min_gap_never`.
+    pub fn min_gap_never(&self) -> bool {
+        self.min_gap_m.is_none()
+    }
+}
+
+/// The run-level figures as written: each "never" flag beside the figures.
+#[derive(Serialize)]
+struct MetricsOut<'a> {
+    #[serde(flatten)]
+    metrics: &'a RunMetrics,
+    min_ttc_never: bool,
+    min_gap_never: bool,
+}
+
+/// A vehicle's figures as written: its figures and their "never" flags.
+#[derive(Serialize)]
+struct VehicleOut<'a> {
+    #[serde(flatten)]
+    row: &'a VehicleRow,
+    slowing_onset_never: Option<bool>,
+    divider_crossing_never: Option<bool>,
+}
+
+/// A vehicle's figures as read: the flags are recomputed from the figures, not trusted.
+#[derive(Deserialize)]
+struct VehicleIn {
+    #[serde(flatten)]
+    row: VehicleRow,
+    #[serde(default, rename = "slowing_onset_never")]
+    _slowing_onset_never: Option<bool>,
+    #[serde(default, rename = "divider_crossing_never")]
+    _divider_crossing_never: Option<bool>,
+}
+
 /// One run of a sweep: one planner on one instance (one JSONL line, without the wall time; one
 /// element of `samples`). Its key is (`instance`, `planner`).
+///
+/// Written with a "never" flag beside each figure whose `null` means it never happened (so
+/// +∞, the best or latest value, not a missing one): `min_ttc_never`, `min_gap_never` and per
+/// vehicle `slowing_onset_never`, `divider_crossing_never` (null when the run kept no paper
+/// figures). The flags are derived from the figures; reading ignores them.
 ///
 /// Read strictly: a `completed` row must carry every figure, well formed (a malformed figure is
 /// an error naming the instance, never a silently "diverged" run); a row without `planner` or
 /// `drawn` was written by an older mergesim and is refused with a message saying so.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RunRow {
     /// Instance index i in `0..runs`.
     pub instance: u64,
     /// The planner of the run (its name, or the scenario's own label: `pf-iso`, `mixed`).
     pub planner: String,
     /// The run's seed, [`instance_seed`](super::instance_seed)`(K, i)`: `merge_sim run --seed
-    /// <seed>` replays it. A string in JSON (exact in every reader); integers are read too.
-    #[serde(with = "crate::exact_seed")]
+    /// <seed>` replays it. A `0x` hex string in JSON (exact in every reader, pandas included);
+    /// decimal strings and integers are read too.
     pub seed: u64,
     /// How it ended.
     pub status: RunStatus,
     /// The error of a diverged or panicked run.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
     /// The values the scenario drew for this instance (see
     /// [`drawn_values`](super::drawn_values)); the same for every planner of an instance.
     pub drawn: BTreeMap<String, f64>,
     /// The figures of a completed run (absent otherwise).
-    #[serde(flatten)]
     pub metrics: Option<RunMetrics>,
     /// Each vehicle's figures, in the scenario's order (empty unless completed).
     pub vehicles: Vec<VehicleRow>,
+}
+
+impl Serialize for RunRow {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        #[derive(Serialize)]
+        struct Wire<'a> {
+            instance: u64,
+            planner: &'a str,
+            #[serde(with = "crate::exact_seed")]
+            seed: u64,
+            status: RunStatus,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            error: &'a Option<String>,
+            drawn: &'a BTreeMap<String, f64>,
+            #[serde(flatten)]
+            metrics: Option<MetricsOut<'a>>,
+            vehicles: Vec<VehicleOut<'a>>,
+        }
+        Wire {
+            instance: self.instance,
+            planner: &self.planner,
+            seed: self.seed,
+            status: self.status,
+            error: &self.error,
+            drawn: &self.drawn,
+            metrics: self.metrics.as_ref().map(|m| MetricsOut {
+                metrics: m,
+                min_ttc_never: m.min_ttc_never(),
+                min_gap_never: m.min_gap_never(),
+            }),
+            vehicles: self
+                .vehicles
+                .iter()
+                .map(|v| VehicleOut {
+                    row: v,
+                    slowing_onset_never: v.slowing_onset_never(),
+                    divider_crossing_never: v.divider_crossing_never(),
+                })
+                .collect(),
+        }
+        .serialize(serializer)
+    }
 }
 
 /// Why a row written by an older mergesim cannot be read.
@@ -135,12 +223,15 @@ impl<'de> Deserialize<'de> for RunRow {
             #[serde(default)]
             drawn: Option<BTreeMap<String, f64>>,
             #[serde(default)]
-            vehicles: Option<Vec<VehicleRow>>,
+            vehicles: Option<Vec<VehicleIn>>,
             #[serde(flatten)]
             rest: serde_json::Map<String, serde_json::Value>,
         }
         let raw = Raw::deserialize(deserializer)?;
         let instance = raw.instance;
+        let raw_vehicles = raw
+            .vehicles
+            .map(|v| v.into_iter().map(|v| v.row).collect::<Vec<_>>());
         let (Some(planner), Some(drawn)) = (raw.planner, raw.drawn) else {
             return Err(D::Error::custom(format!(
                 "instance {instance}: a row without `planner` or `drawn`, {OLD_FORMAT}"
@@ -155,7 +246,7 @@ impl<'de> Deserialize<'de> for RunRow {
                              malformed figures: {e}"
                         ))
                     })?;
-                let vehicles = raw.vehicles.ok_or_else(|| {
+                let vehicles = raw_vehicles.ok_or_else(|| {
                     D::Error::custom(format!(
                         "instance {instance} ({planner}): a completed run without `vehicles`, \
                          {OLD_FORMAT}"
@@ -163,7 +254,7 @@ impl<'de> Deserialize<'de> for RunRow {
                 })?;
                 (Some(metrics), vehicles)
             }
-            RunStatus::Diverged | RunStatus::Panicked => (None, raw.vehicles.unwrap_or_default()),
+            RunStatus::Diverged | RunStatus::Panicked => (None, raw_vehicles.unwrap_or_default()),
         };
         Ok(RunRow {
             instance,

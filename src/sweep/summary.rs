@@ -55,11 +55,25 @@ pub struct SweepSummary {
     pub near_miss_rate: Option<f64>,
     /// 95 % Wilson score interval of the near-miss rate.
     pub near_miss_rate_ci95: Option<[f64; 2]>,
+    /// Values the percentiles are over: the completed runs, a "never" value counted as +∞.
+    #[serde(default)]
+    pub percentiles_n: u64,
     /// 5th percentile (nearest rank) of the runs' minimum TTC (s); a run without a closing pair
     /// counts as +∞, and `null` means the percentile itself is +∞ (or no completed run).
     pub min_ttc_s_p5: Option<f64>,
-    /// 5th percentile (nearest rank) of the runs' minimum gap (m).
+    /// Completed runs in which no pair was ever closing (`min_ttc_never`; +∞ in the percentile).
+    #[serde(default)]
+    pub runs_min_ttc_never: u64,
+    /// 5th percentile (nearest rank) of the runs' minimum gap (m); a run in which no two bodies
+    /// came within range counts as +∞.
     pub min_gap_m_p5: Option<f64>,
+    /// Completed runs in which no two bodies came within range (`min_gap_never`; +∞ in the
+    /// percentile).
+    #[serde(default)]
+    pub runs_min_gap_never: u64,
+    /// Values each mean below is over: the completed runs (these figures are never null).
+    #[serde(default)]
+    pub means_n: u64,
     /// Mean over completed runs of the largest |yaw rate| of any vehicle (rad/s).
     pub mean_peak_yaw_rate_radps: Option<f64>,
     /// Mean over completed runs of the largest |sideslip| of any vehicle (rad).
@@ -201,8 +215,12 @@ impl SweepSummary {
             near_misses,
             near_miss_rate: rate(near_misses),
             near_miss_rate_ci95: wilson_interval(near_misses, completed, Z_95),
+            percentiles_n: completed,
             min_ttc_s_p5: p5(&|m| m.min_ttc_s),
+            runs_min_ttc_never: count(&|m| m.min_ttc_never()),
             min_gap_m_p5: p5(&|m| m.min_gap_m),
+            runs_min_gap_never: count(&|m| m.min_gap_never()),
+            means_n: completed,
             mean_peak_yaw_rate_radps: mean_of(&|m| m.peak_yaw_rate_radps),
             mean_peak_sideslip_rad: mean_of(&|m| m.peak_sideslip_rad),
             mean_peak_yaw_rad: mean_of(&|m| m.peak_yaw_rad),
@@ -268,8 +286,10 @@ impl SweepSummary {
              completed {}  diverged {} (panicked {})\n\
              collisions {}  rate {}  95% CI {}\n\
              near misses {}  rate {}  95% CI {}\n\
-             p5 min TTC {} s  p5 min gap {} m\n\
-             mean peak |r| {} rad/s  mean peak |β| {} rad  mean peak |ψ| {} rad  mean min v {} m/s\n\
+             p5 min TTC {} s  p5 min gap {} m  (n {}: completed runs; a run that never closed \
+             ({}) / never came within range ({}) counts as +inf)\n\
+             means over n {} completed runs: peak |r| {} rad/s  peak |β| {} rad  peak |ψ| {} rad  \
+             min v {} m/s\n\
              fallback cycles {} (in {} runs)\n",
             self.scenario,
             self.planner,
@@ -290,6 +310,10 @@ impl SweepSummary {
             ci(self.near_miss_rate_ci95),
             opt(self.min_ttc_s_p5, 3),
             opt(self.min_gap_m_p5, 3),
+            self.percentiles_n,
+            self.runs_min_ttc_never,
+            self.runs_min_gap_never,
+            self.means_n,
             opt(self.mean_peak_yaw_rate_radps, 4),
             opt(self.mean_peak_sideslip_rad, 4),
             opt(self.mean_peak_yaw_rad, 4),

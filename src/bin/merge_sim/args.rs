@@ -68,10 +68,21 @@ pub(crate) struct RunArgs {
     #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
     pub(crate) planner: Option<PlannerKind>,
     /// Run the scenario instance drawn with seed N from its [randomise] ranges (N also seeds
-    /// the V2V drops); a sweep's per-run rows give each run's seed. Without it the nominal
-    /// scenario runs.
-    #[arg(long, value_name = "N")]
+    /// the V2V drops); a sweep's per-run rows give each run's seed, written as 0x and 16 hex
+    /// digits (decimal is read too; a float such as 9.853264649648847e18 is refused: it lost
+    /// digits). Prints the seed and every value it drew on stderr (and under `drawn` in
+    /// --json). Without it (or --sweep-seed) the nominal scenario runs.
+    #[arg(long, value_name = "N", value_parser = parse_seed,
+          conflicts_with_all = ["sweep_seed", "instance"])]
     pub(crate) seed: Option<u64>,
+    /// With --instance I: run instance I of the sweep with seed K, exactly the run of that
+    /// sweep's row I (seed SplitMix64::derive(K, I)); add the row's --planner for a
+    /// multi-planner sweep.
+    #[arg(long, value_name = "K", value_parser = parse_seed, requires = "instance")]
+    pub(crate) sweep_seed: Option<u64>,
+    /// The instance index of --sweep-seed (a sweep row's `instance`).
+    #[arg(long, value_name = "I", requires = "sweep_seed")]
+    pub(crate) instance: Option<u64>,
     /// Where to write the Rerun recording [default: <scenario>_<planner>.rrd; none in a build
     /// without the cargo feature `rerun`].
     #[arg(long, value_name = "PATH", conflicts_with = "no_rrd")]
@@ -117,6 +128,18 @@ pub(crate) struct RunArgs {
     pub(crate) quiet: bool,
 }
 
+impl RunArgs {
+    /// The seed of the instance to run: --seed, or the seed of --instance of --sweep-seed
+    /// (`None`: the nominal scenario).
+    pub(crate) fn instance_seed(&self) -> Option<u64> {
+        self.seed.or_else(|| {
+            self.sweep_seed
+                .zip(self.instance)
+                .map(|(k, i)| mergesim::sweep::instance_seed(k, i))
+        })
+    }
+}
+
 #[derive(Args, Debug)]
 pub(crate) struct CompareArgs {
     #[command(flatten)]
@@ -126,9 +149,9 @@ pub(crate) struct CompareArgs {
           default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
     pub(crate) planners: Vec<PlannerKind>,
 
-    /// Compare on the scenario instance drawn with seed N (as `run --seed N`); without it the
-    /// nominal scenario.
-    #[arg(long, value_name = "N")]
+    /// Compare on the scenario instance drawn with seed N (as `run --seed N`: decimal or 0x
+    /// hex); without it the nominal scenario.
+    #[arg(long, value_name = "N", value_parser = parse_seed)]
     pub(crate) seed: Option<u64>,
     /// Write the JSON summaries (an array) here.
     #[arg(long, value_name = "PATH")]
@@ -219,9 +242,10 @@ pub(crate) struct SweepArgs {
     /// planner.
     #[arg(long, value_name = "N", value_parser = parse_runs)]
     pub(crate) runs: u64,
-    /// Sweep seed K: instance i runs with seed SplitMix64::derive(K, i), which `run --seed`
-    /// replays.
-    #[arg(long, value_name = "K", default_value_t = 0)]
+    /// Sweep seed K (decimal or 0x hex): instance i runs with seed SplitMix64::derive(K, i),
+    /// which `run --sweep-seed K --instance i` (or `run --seed` with the row's seed) replays.
+    /// The rows carry `sweep_seed` and `instance`.
+    #[arg(long, value_name = "K", default_value = "0", value_parser = parse_seed)]
     pub(crate) seed: u64,
     /// Run only shard i of n (0-based): instances [⌊i·N/n⌋, ⌊(i+1)·N/n⌋). Default: from a Slurm
     /// job array (SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_COUNT), a Kubernetes Indexed Job
@@ -308,8 +332,8 @@ pub(crate) struct GridArgs {
     /// with --seed would (instance i with seed SplitMix64::derive(seed, i)).
     #[arg(long, default_value_t = 0, value_name = "N")]
     pub(crate) runs: u64,
-    /// Sweep seed of the drawn instances.
-    #[arg(long, default_value_t = 0, value_name = "K")]
+    /// Sweep seed of the drawn instances (decimal or 0x hex).
+    #[arg(long, default_value = "0", value_name = "K", value_parser = parse_seed)]
     pub(crate) seed: u64,
     /// Vehicle whose figures the table and the figure compare.
     #[arg(long, default_value = "obstacle", value_name = "NAME")]
@@ -330,6 +354,12 @@ pub(crate) struct GridArgs {
     /// Print nothing but errors.
     #[arg(long, short)]
     pub(crate) quiet: bool,
+}
+
+/// A seed: decimal digits or 0x and hex digits (what the result files write); a float is
+/// refused, as it cannot be an exact seed.
+pub(crate) fn parse_seed(text: &str) -> Result<u64, String> {
+    mergesim::exact_seed::parse_seed(text).map_err(|e| e.to_string())
 }
 
 pub(crate) fn parse_runs(text: &str) -> Result<u64, String> {

@@ -99,8 +99,9 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
     if args.gif.is_some() {
         gif_params.validate().map_err(input)?;
     }
+    let seed = args.instance_seed();
     if let Some(path) = &rrd {
-        let instance = scenario.instance(args.seed);
+        let instance = scenario.instance(seed);
         let bytes = sim::recording::size_estimate::estimated_bytes(
             &instance.sim,
             &instance.vehicles,
@@ -118,10 +119,19 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
             );
         }
     }
+    if let Some(seed) = seed
+        && !args.quiet
+    {
+        // stderr: stdout stays the table it always was.
+        eprint!(
+            "{}",
+            mergesim::sweep::describe_instance(&scenario, seed, args.sweep_seed.zip(args.instance))
+        );
+    }
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let what = Simulation {
         planner: args.planner,
-        seed: args.seed,
+        seed,
         rrd: rrd.as_deref(),
         keep_time_series: args.csv.is_some() || args.gif.is_some(),
         show_progress,
@@ -129,7 +139,8 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
         record_detail: args.record_detail.0,
         follow: Some(&follow),
     };
-    let finished = simulate(&scenario, &what, interrupt)?;
+    let mut finished = simulate(&scenario, &what, interrupt)?;
+    finished.summary = finished.summary.with_drawn(&scenario);
     if let Some(path) = &args.gif {
         let gif = GifRun {
             path,
@@ -221,7 +232,7 @@ fn write_run_gif(
         show_progress,
     } = *gif;
     use mergesim::animation::{GifVehicle, write_gif};
-    let instance = scenario.instance(args.seed);
+    let instance = scenario.instance(args.instance_seed());
     let mut vehicles = Vec::with_capacity(instance.vehicles.len());
     for (id, spec) in instance.vehicles.iter().enumerate() {
         let car = vehicles::VehicleParams::preset(&spec.preset).map_err(input)?;
@@ -294,7 +305,7 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
             ..Simulation::default()
         };
         let finished = simulate(&scenario, &what, interrupt)?;
-        summaries.push(finished.summary);
+        summaries.push(finished.summary.with_drawn(&scenario));
         time_series.push(finished.outcome.time_series);
         collisions.push(finished.outcome.safety.collisions);
     }

@@ -208,7 +208,7 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
                 } else {
                     String::new()
                 },
-                row.seed,
+                mergesim::exact_seed::format_seed(row.seed),
                 row.status,
                 row.error.as_deref().unwrap_or_default()
             );
