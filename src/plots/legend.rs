@@ -66,8 +66,8 @@ pub(crate) const CAPTION_PX: u32 = 28;
 
 /// Splits `panel` into the chart's area (left) and a legend column (right) wide enough for
 /// the labels of `entries`.
-pub(super) fn split_for_legend<'a, 'b>(
-    panel: &'b DrawingArea<BitMapBackend<'a>, Shift>,
+pub(super) fn split_for_legend<'a>(
+    panel: &DrawingArea<BitMapBackend<'a>, Shift>,
     entries: &[LegendEntry],
 ) -> (
     DrawingArea<BitMapBackend<'a>, Shift>,
