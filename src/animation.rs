@@ -1,17 +1,24 @@
 //! `merge_sim run --gif`: a top-down animated GIF of a run, drawn on the CPU with plotters (no
 //! GPU, no display), from the run's time series — so a run can be shown in a paper or an issue.
 //!
-//! Each frame shows a window of road that follows one vehicle (the same window as the Rerun
-//! follow view: [`GifParams::behind_m`] behind it, [`GifParams::ahead_m`] ahead, the road's
-//! whole width), the road edges, the lane divider, the merge section (orange), every vehicle as
-//! its oriented footprint in its colour (the recording's palette) with its name, and a header
+//! Each frame shows, as [`GifParams::view`] says, either the whole road with every vehicle
+//! (scaled to the picture's width, as the recording's whole-road view; [`GifView::Road`]) or a
+//! window that follows one vehicle (the recording's follow view: [`GifParams::behind_m`] behind
+//! it, [`GifParams::ahead_m`] ahead, the road's whole width; [`GifView::Follow`]). Drawn: the
+//! road edges, the lane divider, the merge section (orange), every vehicle as its oriented
+//! footprint in its colour ([`sim::recording::vehicle_color`], the same RGB as in the recording
+//! and the figures: the GIF's palette keeps these colours exact) with its name, and a header
 //! with the time, the followed vehicle's speed and the last collision. Vehicles in a collision
 //! are outlined in red from its time on. Playback is real time by default: one frame per
 //! `1 / fps` s of simulated time, shown for `1 / fps` s.
 
+mod frame;
+mod palette;
+
+pub use frame::FrameGeometry;
+
 use std::path::{Path, PathBuf};
 
-use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 use sim::TimeSeriesRow;
@@ -20,7 +27,40 @@ use sim::safety::CollisionEvent;
 use thiserror::Error;
 
 use crate::output::temporary_path;
-use crate::plots::{ensure_font, font};
+use crate::plots::ensure_font;
+use frame::{FrameScene, draw_frame};
+
+/// Which part of the road the frames show.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GifView {
+    /// The whole road with every vehicle in every frame, scaled to the picture's width (across
+    /// the road stretched so the lanes stay visible on a long road).
+    Road,
+    /// A window around the followed vehicle; vehicles outside it are not drawn.
+    #[default]
+    Follow,
+}
+
+impl GifView {
+    /// The view `merge_sim run --gif` takes unless told: the whole road when more than two
+    /// vehicles run (others would drop out of a window), else the follow view.
+    pub fn default_for(vehicles: usize) -> Self {
+        if vehicles > 2 {
+            GifView::Road
+        } else {
+            GifView::Follow
+        }
+    }
+
+    /// Its name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            GifView::Road => "road",
+            GifView::Follow => "follow",
+        }
+    }
+}
 
 /// Options of the animation.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -37,6 +77,8 @@ pub struct GifParams {
     pub ahead_m: f64,
     /// Margin beside the road's edges (m).
     pub margin_m: f64,
+    /// The whole road or the window around the followed vehicle (`behind_m`, `ahead_m`).
+    pub view: GifView,
 }
 
 impl Default for GifParams {
@@ -47,12 +89,10 @@ impl Default for GifParams {
             behind_m: 30.0,
             ahead_m: 50.0,
             margin_m: 2.0,
+            view: GifView::Follow,
         }
     }
 }
-
-/// Height of the header line (pixels).
-const HEADER_PX: u32 = 22;
 
 /// What the animation shows of one vehicle.
 #[derive(Clone, Debug, PartialEq)]
@@ -138,14 +178,10 @@ impl GifParams {
         Ok(())
     }
 
-    /// The picture size (pixels) for a road of width `road_width_m`.
-    pub fn size_px(&self, road_width_m: f64) -> (u32, u32) {
-        let px_per_m = f64::from(self.width_px) / (self.behind_m + self.ahead_m);
-        let road_px = ((road_width_m + 2.0 * self.margin_m) * px_per_m).ceil();
-        (
-            self.width_px,
-            HEADER_PX + road_px.clamp(16.0, 4000.0) as u32,
-        )
+    /// The picture size (pixels) of the follow view of `road` (the road view's depends on the
+    /// run: [`FrameGeometry::whole_road`]).
+    pub fn size_px(&self, road: &sim::MergeRoad) -> (u32, u32) {
+        FrameGeometry::follow(road, self, 0.0).size_px
     }
 }
 
@@ -166,14 +202,6 @@ fn frame_instants<'a>(all: &[&'a [TimeSeriesRow]], fps: f64) -> Vec<&'a [TimeSer
         }
     }
     out
-}
-
-/// The corners of a footprint centred at (x, y) with heading `yaw`.
-fn footprint(x: f64, y: f64, yaw: f64, length: f64, width: f64) -> [(f64, f64); 4] {
-    let (s, c) = yaw.sin_cos();
-    let (hl, hw) = (0.5 * length, 0.5 * width);
-    [(hl, hw), (-hl, hw), (-hl, -hw), (hl, -hw)]
-        .map(|(dx, dy)| (x + c * dx - s * dy, y + s * dx + c * dy))
 }
 
 /// Writes the animation of a run to `path` (through a temporary file, renamed when complete):
@@ -212,23 +240,60 @@ pub fn write_gif(
         message: e.to_string(),
     };
     ensure_font().map_err(|e| draw_err(&e))?;
-    let road_width_m = road.y_upper_m() - road.y_bottom_m;
-    let size = params.size_px(road_width_m);
-    let delay_cs = (100.0 / params.fps).round().max(1.0);
+    let whole_road = FrameGeometry::whole_road(road, params, rows);
+    let size = match params.view {
+        GifView::Road => whole_road.size_px,
+        GifView::Follow => params.size_px(road),
+    };
+    let scene = FrameScene {
+        road,
+        vehicles,
+        collisions,
+        follow,
+        title,
+        view: params.view,
+    };
+    // The vehicles' colours keep their own palette entries in every frame.
+    let keep: Vec<[u8; 3]> = vehicles.iter().map(|v| vehicle_color(v.id)).collect();
+    let delay_cs = (100.0 / params.fps).round().max(1.0) as u16;
     let tmp = temporary_path(path);
     let result = (|| {
-        let backend =
-            BitMapBackend::gif(&tmp, size, (10.0 * delay_cs) as u32).map_err(|e| draw_err(&e))?;
-        let root = backend.into_drawing_area();
+        let file = std::fs::File::create(&tmp).map_err(|e| draw_err(&e))?;
+        let (w16, h16) = (
+            u16::try_from(size.0).map_err(|e| draw_err(&e))?,
+            u16::try_from(size.1).map_err(|e| draw_err(&e))?,
+        );
+        let mut encoder = gif::Encoder::new(std::io::BufWriter::new(file), w16, h16, &[])
+            .map_err(|e| draw_err(&e))?;
+        encoder
+            .set_repeat(gif::Repeat::Infinite)
+            .map_err(|e| draw_err(&e))?;
+        let mut buffer = vec![0u8; 3 * size.0 as usize * size.1 as usize];
         let n = frames.len();
         for (k, instant) in frames.iter().enumerate() {
-            draw_frame(
-                &root, road, vehicles, instant, collisions, follow, title, params, size,
-            )
-            .map_err(|e| draw_err(&e))?;
-            root.present().map_err(|e| draw_err(&e))?;
+            let geometry = match params.view {
+                GifView::Road => whole_road,
+                GifView::Follow => {
+                    let x_c = instant
+                        .iter()
+                        .find(|r| r.vehicle == follow)
+                        .map_or(0.0, |r| r.x_m);
+                    FrameGeometry::follow(road, params, x_c)
+                }
+            };
+            {
+                let root = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
+                draw_frame(&root, &scene, instant, &geometry).map_err(|e| draw_err(&e))?;
+                root.present().map_err(|e| draw_err(&e))?;
+            }
+            let (colors, indices) = palette::index_frame(&buffer, &keep);
+            let mut frame = gif::Frame::from_palette_pixels(w16, h16, &indices, &colors, None);
+            frame.delay = delay_cs;
+            encoder.write_frame(&frame).map_err(|e| draw_err(&e))?;
             progress((k + 1) as f64 / n as f64);
         }
+        let mut writer = encoder.into_inner().map_err(|e| draw_err(&e))?;
+        std::io::Write::flush(&mut writer).map_err(|e| draw_err(&e))?;
         Ok::<_, GifError>(n)
     })();
     let n = match result {
@@ -253,128 +318,13 @@ pub fn write_gif(
     })
 }
 
-#[allow(clippy::too_many_arguments)]
-fn draw_frame(
-    root: &DrawingArea<BitMapBackend<'_>, Shift>,
-    road: &sim::MergeRoad,
-    vehicles: &[GifVehicle],
-    instant: &[TimeSeriesRow],
-    collisions: &[CollisionEvent],
-    follow: &str,
-    title: &str,
-    params: &GifParams,
-    (w, _h): (u32, u32),
-) -> Result<(), String> {
-    let e = |err: &dyn std::fmt::Display| err.to_string();
-    root.fill(&RGBColor(40, 40, 44)).map_err(|x| e(&x))?;
-    let t_s = instant.first().map_or(0.0, |r| r.t_s);
-    let followed = instant.iter().find(|r| r.vehicle == follow);
-    let x_c = followed.map_or(0.0, |r| r.x_m);
-    let px_per_m = f64::from(w) / (params.behind_m + params.ahead_m);
-    let x0 = x_c - params.behind_m;
-    let y_top = road.y_upper_m() + params.margin_m;
-    // Road coordinates to pixels: X to the right, Y up.
-    let to_px = |x: f64, y: f64| -> (i32, i32) {
-        (
-            ((x - x0) * px_per_m).round() as i32,
-            (f64::from(HEADER_PX) + (y_top - y) * px_per_m).round() as i32,
-        )
-    };
-    // Merge section.
-    let (mx0, my0) = to_px(road.merge_start_x_m, road.y_upper_m());
-    let (mx1, my1) = to_px(road.merge_end_x_m, road.y_bottom_m);
-    root.draw(&Rectangle::new(
-        [(mx0, my0), (mx1, my1)],
-        RGBColor(75, 58, 38).filled(),
-    ))
-    .map_err(|x| e(&x))?;
-    // Edges and divider.
-    let line = |pts: &[[f64; 2]]| pts.iter().map(|p| to_px(p[0], p[1])).collect::<Vec<_>>();
-    for edge in [road.upper_edge_polyline(), road.lower_edge_polyline()] {
-        root.draw(&PathElement::new(
-            line(&edge),
-            ShapeStyle::from(&RGBColor(230, 230, 230)).stroke_width(2),
-        ))
-        .map_err(|x| e(&x))?;
-    }
-    let divider = [
-        [road.start_x_m, road.y_lane_m()],
-        [road.merge_end_x_m, road.y_lane_m()],
-    ];
-    root.draw(&PathElement::new(
-        line(&divider),
-        ShapeStyle::from(&RGBColor(240, 200, 60)).stroke_width(1),
-    ))
-    .map_err(|x| e(&x))?;
-    // Vehicles.
-    for row in instant {
-        let Some(v) = vehicles.iter().find(|v| v.name == row.vehicle) else {
-            continue;
-        };
-        if ![row.x_m, row.y_m, row.yaw_rad]
-            .iter()
-            .all(|c| c.is_finite())
-        {
-            continue;
-        }
-        let corners = footprint(row.x_m, row.y_m, row.yaw_rad, v.length_m, v.width_m)
-            .map(|(x, y)| to_px(x, y));
-        // Outside the window: not drawn (its label would be pinned to the picture's edge).
-        if corners.iter().all(|&(x, _)| x < 0) || corners.iter().all(|&(x, _)| x >= w as i32) {
-            continue;
-        }
-        let [r, g, b] = vehicle_color(v.id);
-        root.draw(&Polygon::new(corners.to_vec(), RGBColor(r, g, b).filled()))
-            .map_err(|x| e(&x))?;
-        let crashed = collisions
-            .iter()
-            .any(|c| c.t_s <= t_s + 1e-9 && c.involves(v.id));
-        if crashed {
-            let mut outline = corners.to_vec();
-            outline.push(corners[0]);
-            root.draw(&PathElement::new(
-                outline,
-                ShapeStyle::from(&RGBColor(255, 40, 40)).stroke_width(3),
-            ))
-            .map_err(|x| e(&x))?;
-        }
-        let (lx, ly) = to_px(row.x_m - 0.5 * v.length_m, row.y_m + 0.5 * v.width_m);
-        root.draw(&Text::new(
-            v.name.clone(),
-            (lx, ly - 13),
-            font(12).color(&RGBColor(235, 235, 235)),
-        ))
-        .map_err(|x| e(&x))?;
-    }
-    // Header.
-    root.draw(&Rectangle::new(
-        [(0, 0), (w as i32, HEADER_PX as i32)],
-        RGBColor(20, 20, 22).filled(),
-    ))
-    .map_err(|x| e(&x))?;
-    let speed = followed.map_or(String::new(), |r| {
-        format!("  {follow} {:.1} m/s  x = {:.0} m", r.speed_mps, r.x_m)
-    });
-    let crash = collisions
-        .iter()
-        .rfind(|c| c.t_s <= t_s + 1e-9)
-        .map_or(String::new(), |c| format!("  COLLISION at {:.2} s", c.t_s));
-    root.draw(&Text::new(
-        format!("{title}  t = {t_s:5.2} s{speed}{crash}"),
-        (6, 4),
-        font(14).color(&RGBColor(240, 240, 240)),
-    ))
-    .map_err(|x| e(&x))?;
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn footprint_is_rotated_about_the_centre() {
-        let c = footprint(10.0, 2.0, std::f64::consts::FRAC_PI_2, 4.0, 2.0);
+        let c = frame::footprint(10.0, 2.0, std::f64::consts::FRAC_PI_2, 4.0, 2.0);
         // Heading +Y: the front corners are 2 m up.
         assert!((c[0].1 - 4.0).abs() < 1e-12 && (c[0].0 - 9.0).abs() < 1e-12);
     }
@@ -418,12 +368,8 @@ mod tests {
         }
     }
 
-    /// One frame drawn into memory.
-    fn frame(instant: &[TimeSeriesRow]) -> Vec<u8> {
-        let road = sim::MergeRoad::default();
-        let params = GifParams::default();
-        let size = params.size_px(road.y_upper_m() - road.y_bottom_m);
-        let vehicles: Vec<GifVehicle> = ["ego", "far"]
+    fn vehicles() -> Vec<GifVehicle> {
+        ["ego", "far"]
             .iter()
             .zip(0..)
             .map(|(name, id)| GifVehicle {
@@ -432,25 +378,40 @@ mod tests {
                 length_m: 4.5,
                 width_m: 1.8,
             })
-            .collect();
+            .collect()
+    }
+
+    /// One frame drawn into memory with `geometry`.
+    fn draw(instant: &[TimeSeriesRow], view: GifView, geometry: &FrameGeometry) -> Vec<u8> {
+        let road = sim::MergeRoad::default();
+        let vehicles = vehicles();
+        let size = geometry.size_px;
         let mut buffer = vec![0u8; (size.0 * size.1 * 3) as usize];
         {
             let root = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
-            draw_frame(
-                &root,
-                &road,
-                &vehicles,
-                instant,
-                &[],
-                "ego",
-                "test",
-                &params,
-                size,
-            )
-            .unwrap_or_else(|e| panic!("{e}"));
+            let scene = FrameScene {
+                road: &road,
+                vehicles: &vehicles,
+                collisions: &[],
+                follow: "ego",
+                title: "test",
+                view,
+            };
+            draw_frame(&root, &scene, instant, geometry).unwrap_or_else(|e| panic!("{e}"));
             root.present().unwrap_or_else(|e| panic!("{e}"));
         }
         buffer
+    }
+
+    /// One frame of the follow view, following `ego`.
+    fn frame(instant: &[TimeSeriesRow]) -> Vec<u8> {
+        let road = sim::MergeRoad::default();
+        let x_c = instant
+            .iter()
+            .find(|r| r.vehicle == "ego")
+            .map_or(0.0, |r| r.x_m);
+        let geometry = FrameGeometry::follow(&road, &GifParams::default(), x_c);
+        draw(instant, GifView::Follow, &geometry)
     }
 
     #[test]
@@ -472,6 +433,43 @@ mod tests {
             frame(&[row("ego", 100.0, 1.75), row("far", 120.0, 5.25)]),
             alone
         );
+    }
+
+    #[test]
+    fn the_road_view_shows_every_vehicle_at_its_place() {
+        ensure_font().unwrap_or_else(|e| panic!("{e}"));
+        let road = sim::MergeRoad::default();
+        // The same two vehicles, 300 m apart: the follow view loses one, the road view has both.
+        let instant = [row("ego", 0.0, 1.75), row("far", 300.0, 5.25)];
+        let geometry = FrameGeometry::whole_road(&road, &GifParams::default(), &instant);
+        assert_eq!(geometry.size_px.0, 800);
+        let pixels = draw(&instant, GifView::Road, &geometry);
+        let at = |(x, y): (i32, i32)| {
+            let i = 3 * (y as usize * geometry.size_px.0 as usize + x as usize);
+            [pixels[i], pixels[i + 1], pixels[i + 2]]
+        };
+        for (id, r) in instant.iter().enumerate() {
+            assert_eq!(
+                at(geometry.to_px(r.x_m, r.y_m)),
+                vehicle_color(id as u32),
+                "{} not drawn at its place",
+                r.vehicle
+            );
+        }
+        let followed = frame(&instant);
+        let has = |buffer: &[u8], rgb: [u8; 3]| buffer.chunks(3).any(|p| p == rgb);
+        assert!(has(&followed, vehicle_color(0)) && !has(&followed, vehicle_color(1)));
+        // The road and every position fit: the road's ends map inside the picture.
+        let (x_start, _) = geometry.to_px(road.start_x_m, road.y_lane_m());
+        let (x_end, _) = geometry.to_px(road.end_x_m, road.y_lane_m());
+        assert!(x_start >= 0 && x_end < 800, "{x_start} {x_end}");
+    }
+
+    #[test]
+    fn the_default_view_is_the_road_beyond_two_vehicles() {
+        assert_eq!(GifView::default_for(1), GifView::Follow);
+        assert_eq!(GifView::default_for(2), GifView::Follow);
+        assert_eq!(GifView::default_for(3), GifView::Road);
     }
 
     #[test]

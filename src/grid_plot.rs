@@ -9,7 +9,8 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use crate::grid::{GridMetric, GridOutcome};
-use crate::plots::{PlotError, ensure_font, font, render_png};
+use crate::plots::{CAPTION_PX, PlotError, draw_caption, ensure_font, font, render_png};
+use crate::run_caption::RunCaption;
 
 /// Colour of a ratio: green below 1, white at 1, red above (saturating at ½ and 2).
 fn ratio_color(ratio: f64) -> RGBColor {
@@ -26,12 +27,27 @@ fn ratio_color(ratio: f64) -> RGBColor {
     }
 }
 
-/// Writes the figure of `metric` for `vehicle` to `path`.
+/// The caption line of the grid figure: `caption` with the grid's instances.
+pub fn grid_caption_line(caption: &RunCaption, outcome: &GridOutcome) -> String {
+    let instances = if outcome.runs == 0 {
+        "nominal".to_string()
+    } else {
+        format!(
+            "{} instances per cell, sweep seed {}",
+            outcome.runs, outcome.seed
+        )
+    };
+    caption.line_with(&instances)
+}
+
+/// Writes the figure of `metric` for `vehicle` to `path`, under a caption band saying
+/// [`grid_caption_line`].
 pub fn write_grid_png(
     path: &Path,
     outcome: &GridOutcome,
     vehicle: &str,
     metric: GridMetric,
+    caption: &RunCaption,
 ) -> Result<(), PlotError> {
     ensure_font()?;
     let diffs = outcome.paired_differences(vehicle, metric);
@@ -55,10 +71,14 @@ pub fn write_grid_png(
     let (cell_w, cell_h) = (96i32, 44i32);
     let (left, top, panel_gap) = (190i32, 70i32, 60i32);
     let panel_h = top + cell_h * rows.len() as i32 + 40;
-    let width = (left + cell_w * cols.len() as i32 + 30) as u32;
-    let height = (panel_h * compared.len() as i32 + panel_gap) as u32;
+    let caption_line = grid_caption_line(caption, outcome);
+    // Wide enough for the caption too (about 8 px per character at its size).
+    let width = ((left + cell_w * cols.len() as i32 + 30) as u32)
+        .max(8 * caption_line.chars().count() as u32 + 20);
+    let height = (panel_h * compared.len() as i32 + panel_gap) as u32 + CAPTION_PX;
     let metric_name = metric.label();
-    render_png(path, (width, height), |area| {
+    render_png(path, (width, height), |root| {
+        let area = &draw_caption(root, &caption_line, None)?;
         for (k, planner) in compared.iter().enumerate() {
             let y0 = k as i32 * panel_h + 10;
             let title = format!(

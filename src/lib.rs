@@ -17,6 +17,7 @@ pub mod limits;
 pub mod output;
 pub mod plots;
 pub mod report;
+pub mod run_caption;
 pub mod scaling;
 pub mod summary;
 pub mod sweep;

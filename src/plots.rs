@@ -7,6 +7,10 @@
 //! Vera licence, `docs/fonts/LICENSE-DejaVu.txt`), so no
 //! system font library (fontconfig, freetype) is needed to build or run.
 //!
+//! Every figure opens with a caption band naming the scenario, the parameter set and the
+//! simulator's commit ([`crate::run_caption::RunCaption`]); every panel's legend sits right of
+//! its chart, outside the plotting area, so it covers no data.
+//!
 //! Every file is written whole or not at all ([`crate::output::write_atomically`]).
 
 use std::ops::Range;
@@ -15,16 +19,22 @@ use std::sync::OnceLock;
 
 use planner::MergeRoad;
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 use sim::TimeSeriesRow;
 use sim::safety::CollisionEvent;
 
 use crate::output::{temporary_path, write_atomically};
+use crate::run_caption::RunCaption;
 
+mod legend;
 mod motion_states;
 mod paths;
 
+pub use legend::PixelBox;
+pub(crate) use legend::{CAPTION_PX, draw_caption};
+use legend::{LegendEntry, draw_legend};
 use motion_states::draw_states;
 use paths::draw_paths;
 
@@ -82,10 +92,52 @@ pub(crate) fn planner_stroke(index: usize, count: usize) -> u32 {
     2 + count.saturating_sub(index + 1).min(3) as u32
 }
 
-/// Colour of the `index`-th vehicle (by id): the recording's and the GIF's palette.
+/// Colour of the vehicle with id `index` ([`sim::recording::vehicle_color`]): the same RGB as
+/// in the recording and the GIF.
 pub(crate) fn vehicle_rgb(index: usize) -> RGBColor {
     let [r, g, b] = sim::recording::vehicle_color(u32::try_from(index).unwrap_or(u32::MAX));
     RGBColor(r, g, b)
+}
+
+/// Where a panel of a figure was drawn (figure pixels): its chart's mapping from data to
+/// pixels, its plotting area and its legend's box.
+#[derive(Clone)]
+pub struct PanelLayout {
+    /// Data (x, y) to figure pixels, as the chart drew them.
+    pub coord: Cartesian2d<RangedCoordf64, RangedCoordf64>,
+    /// The plotting area.
+    pub plot_px: PixelBox,
+    /// The legend's box.
+    pub legend_px: PixelBox,
+}
+
+impl PanelLayout {
+    /// The pixel of data point (x, y).
+    pub fn to_px(&self, x: f64, y: f64) -> (i32, i32) {
+        self.coord.translate(&(x, y))
+    }
+}
+
+/// Draws the legend `entries` in `legend_area`, level with the top of `chart`'s plotting area,
+/// and returns the panel's layout.
+fn panel_layout(
+    chart: &ChartContext<'_, BitMapBackend<'_>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    legend_area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    entries: &[LegendEntry],
+) -> Result<PanelLayout, String> {
+    let (xs, ys) = chart.plotting_area().get_pixel_range();
+    let top = ys.start - legend_area.get_base_pixel().1;
+    let legend_px = draw_legend(legend_area, entries, top.max(0))?;
+    Ok(PanelLayout {
+        coord: chart.as_coord_spec().clone(),
+        plot_px: PixelBox {
+            x0: xs.start,
+            y0: ys.start,
+            x1: xs.end,
+            y1: ys.end,
+        },
+        legend_px,
+    })
 }
 
 /// The position and time of each vehicle of `rows` at each collision of `collisions`: the
@@ -234,12 +286,13 @@ pub fn comparison_csv(series: &[PlannerSeries<'_>]) -> String {
 }
 
 /// Writes [`PATHS_PNG`], one [`states_png`] per vehicle and [`TIME_SERIES_CSV`] into `dir`;
-/// returns the written paths in that order.
+/// returns the written paths in that order. Every figure's caption band says `caption`.
 pub fn write_comparison(
     dir: &Path,
     road: &MergeRoad,
     series: &[PlannerSeries<'_>],
     size: FigureSize,
+    caption: &RunCaption,
 ) -> Result<Vec<PathBuf>, PlotError> {
     if series.is_empty() || series.iter().all(|s| s.rows.is_empty()) {
         return Err(PlotError::Empty(
@@ -264,16 +317,15 @@ pub fn write_comparison(
     }
 
     let path = dir.join(PATHS_PNG);
-    let height = size.panel_height_px * series.len() as u32;
-    render_png(&path, (size.width_px, height), |area| {
-        draw_paths(area, road, series, &vehicles)
+    render_png(&path, paths_size(size, series.len()), |area| {
+        draw_paths_figure(area, road, series, &vehicles, caption).map(|_| ())
     })?;
     written.push(path);
 
-    for vehicle in &vehicles {
+    for (id, vehicle) in vehicles.iter().enumerate() {
         let path = dir.join(states_png(vehicle));
-        render_png(&path, (size.width_px, 4 * size.panel_height_px), |area| {
-            draw_states(area, series, vehicle)
+        render_png(&path, states_size(size), |area| {
+            draw_states_figure(area, series, vehicle, id, caption).map(|_| ())
         })?;
         written.push(path);
     }
@@ -288,6 +340,45 @@ pub fn write_comparison(
 }
 
 pub(crate) type DrawResult = Result<(), String>;
+
+/// Pixel size of the paths figure of `planners` panels.
+fn paths_size(size: FigureSize, planners: usize) -> (u32, u32) {
+    (
+        size.width_px,
+        CAPTION_PX + size.panel_height_px * planners as u32,
+    )
+}
+
+/// Pixel size of a motion-state figure (four panels).
+fn states_size(size: FigureSize) -> (u32, u32) {
+    (size.width_px, CAPTION_PX + 4 * size.panel_height_px)
+}
+
+/// Fig. 3 under its caption band.
+fn draw_paths_figure(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    road: &MergeRoad,
+    series: &[PlannerSeries<'_>],
+    vehicles: &[String],
+    caption: &RunCaption,
+) -> Result<Vec<PanelLayout>, String> {
+    let rest = draw_caption(area, &caption.line(), None)?;
+    draw_paths(&rest, road, series, vehicles)
+}
+
+/// Fig. 4 of vehicle `id` (`vehicle`) under its caption band, which starts with a square in
+/// the vehicle's colour.
+fn draw_states_figure(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    series: &[PlannerSeries<'_>],
+    vehicle: &str,
+    id: usize,
+    caption: &RunCaption,
+) -> Result<Vec<PanelLayout>, String> {
+    let text = format!("{vehicle} — {}", caption.line());
+    let rest = draw_caption(area, &text, Some(vehicle_rgb(id)))?;
+    draw_states(&rest, series, vehicle)
+}
 
 /// Renders into a temporary PNG beside `path` (plotters encodes to a file), then moves the bytes
 /// into place with [`write_atomically`].
@@ -350,6 +441,187 @@ fn padded_range(values: impl Iterator<Item = f64>, margin: f64, min_span: f64) -
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn caption() -> RunCaption {
+        RunCaption {
+            scenario: "urgent_merge".into(),
+            params: "mergesim".into(),
+            seed: None,
+            commit: "0123456789ab".into(),
+        }
+    }
+
+    /// Draws a figure into memory: its RGB pixels and what `draw` returned.
+    fn render_in_memory<T>(
+        size: (u32, u32),
+        draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<T, String>,
+    ) -> (Vec<u8>, T) {
+        ensure_font().unwrap_or_else(|e| panic!("{e}"));
+        let mut buffer = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+        let layout = {
+            let area = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
+            area.fill(&WHITE).unwrap_or_else(|e| panic!("{e}"));
+            let layout = draw(&area).unwrap_or_else(|e| panic!("{e}"));
+            area.present().unwrap_or_else(|e| panic!("{e}"));
+            layout
+        };
+        (buffer, layout)
+    }
+
+    /// The colour of pixel (x, y) of an RGB buffer `width` wide.
+    fn pixel(buffer: &[u8], width: u32, (x, y): (i32, i32)) -> Option<[u8; 3]> {
+        if x < 0 || y < 0 || x >= width as i32 {
+            return None;
+        }
+        let i = 3 * (y as usize * width as usize + x as usize);
+        buffer.get(i..i + 3).map(|p| [p[0], p[1], p[2]])
+    }
+
+    /// Checks that the legends of `layouts` stay out of their plotting areas and that every
+    /// point of `points` (data coordinates) with t ≤ 2 s is drawn, visible, in `color`: its
+    /// pixel or one next to it has exactly that colour (a legend over it would hide or blend it).
+    fn assert_first_seconds_visible(
+        buffer: &[u8],
+        width: u32,
+        layouts: &[PanelLayout],
+        points: &dyn Fn(usize) -> Vec<(f64, f64, f64)>,
+        color: RGBColor,
+    ) {
+        let rgb = [color.0, color.1, color.2];
+        for (k, layout) in layouts.iter().enumerate() {
+            assert!(
+                !layout.legend_px.intersects(&layout.plot_px),
+                "panel {k}: legend {:?} inside the plotting area {:?}",
+                layout.legend_px,
+                layout.plot_px
+            );
+            let early: Vec<(f64, f64, f64)> =
+                points(k).into_iter().filter(|p| p.0 <= 2.0).collect();
+            assert!(early.len() >= 20, "panel {k}: too few points to test");
+            for &(t, x, y) in &early {
+                let (px, py) = layout.to_px(x, y);
+                assert!(
+                    !layout.legend_px.contains((px, py)),
+                    "panel {k}: the legend covers the point at t = {t} s"
+                );
+                let seen = (-1..=1).any(|dx| {
+                    (-1..=1).any(|dy| pixel(buffer, width, (px + dx, py + dy)) == Some(rgb))
+                });
+                assert!(
+                    seen,
+                    "panel {k}: the point at t = {t} s ({px}, {py}) is hidden: {:?}",
+                    pixel(buffer, width, (px, py))
+                );
+            }
+        }
+    }
+
+    /// A vehicle whose every motion state sweeps its whole range in the first 2 s (where a
+    /// legend in a corner of the chart sat), then settles: 20 s at 20 Hz.
+    fn sweeping_rows() -> Vec<TimeSeriesRow> {
+        (1..=400)
+            .map(|k| {
+                let t = 0.05 * f64::from(k);
+                let v = if t <= 2.0 {
+                    (2.0 * std::f64::consts::PI * 2.5 * t).sin()
+                } else {
+                    0.3 * (0.5 * t).sin()
+                };
+                TimeSeriesRow {
+                    t_s: t,
+                    vehicle: "ego".into(),
+                    x_m: 15.0 * t,
+                    y_m: 3.5 + 3.0 * v,
+                    yaw_rad: v,
+                    yaw_rate_radps: v,
+                    sideslip_rad: v,
+                    speed_mps: 15.0 + 5.0 * v,
+                    planned_speed_mps: 15.0,
+                    accel_long_mps2: 0.0,
+                    accel_lat_mps2: 0.0,
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn legends_cover_no_data_in_the_first_two_seconds() {
+        let rows = sweeping_rows();
+        let series = [PlannerSeries {
+            planner: "pf-iso",
+            rows: &rows,
+            collisions: &[],
+        }];
+        let size = FigureSize::default();
+        // Fig. 4: the four panels, one line (the planner's colour).
+        let dims = states_size(size);
+        let (buffer, layouts) = render_in_memory(dims, |area| {
+            draw_states_figure(area, &series, "ego", 0, &caption())
+        });
+        assert_eq!(layouts.len(), 4);
+        type Getter = fn(&TimeSeriesRow) -> f64;
+        let getters: [Getter; 4] = [
+            |r| r.sideslip_rad,
+            |r| r.yaw_rad,
+            |r| r.yaw_rate_radps,
+            |r| r.speed_mps,
+        ];
+        let points = |k: usize| -> Vec<(f64, f64, f64)> {
+            rows.iter().map(|r| (r.t_s, r.t_s, getters[k](r))).collect()
+        };
+        assert_first_seconds_visible(
+            &buffer,
+            dims.0,
+            &layouts,
+            &points,
+            planner_color("pf-iso", 0),
+        );
+        // Fig. 3: the path, weaving across the road in the first 2 s (the vehicle's colour).
+        let dims = paths_size(size, 1);
+        let (buffer, layouts) = render_in_memory(dims, |area| {
+            draw_paths_figure(
+                area,
+                &MergeRoad::default(),
+                &series,
+                &["ego".to_string()],
+                &caption(),
+            )
+        });
+        let points = |_: usize| -> Vec<(f64, f64, f64)> {
+            rows.iter().map(|r| (r.t_s, r.x_m, r.y_m)).collect()
+        };
+        assert_first_seconds_visible(&buffer, dims.0, &layouts, &points, vehicle_rgb(0));
+    }
+
+    #[test]
+    fn figures_open_with_the_caption_band() {
+        let rows = sweeping_rows();
+        let series = [PlannerSeries {
+            planner: "pf-iso",
+            rows: &rows,
+            collisions: &[],
+        }];
+        let dims = states_size(FigureSize::default());
+        // Vehicle id 3: the square before the caption is its colour.
+        let (buffer, layouts) = render_in_memory(dims, |area| {
+            draw_states_figure(area, &series, "ego", 3, &caption())
+        });
+        let band_dark = (0..CAPTION_PX as i32)
+            .flat_map(|y| (0..dims.0 as i32).map(move |x| (x, y)))
+            .filter(|&p| pixel(&buffer, dims.0, p).is_some_and(|c| c.iter().all(|&v| v < 120)))
+            .count();
+        assert!(
+            band_dark > 200,
+            "no caption text drawn ({band_dark} dark pixels)"
+        );
+        let swatch = vehicle_rgb(3);
+        assert_eq!(
+            pixel(&buffer, dims.0, (16, 14)),
+            Some([swatch.0, swatch.1, swatch.2])
+        );
+        // The charts start below the band.
+        assert!(layouts.iter().all(|l| l.plot_px.y0 >= CAPTION_PX as i32));
+    }
 
     fn row(t_s: f64, vehicle: &str, x_m: f64, y_m: f64) -> TimeSeriesRow {
         TimeSeriesRow {
@@ -461,7 +733,8 @@ mod tests {
             width_px: 400,
             panel_height_px: 120,
         };
-        let written = write_comparison(&dir, &MergeRoad::default(), &series, size).unwrap();
+        let written =
+            write_comparison(&dir, &MergeRoad::default(), &series, size, &caption()).unwrap();
         let names: Vec<String> = written
             .iter()
             .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
@@ -486,8 +759,8 @@ mod tests {
             let bytes = std::fs::read(dir.join(name)).unwrap();
             u32::from_be_bytes(bytes[20..24].try_into().unwrap())
         };
-        assert_eq!(height("paths.png"), 2 * 120);
-        assert_eq!(height("states_obstacle.png"), 4 * 120);
+        assert_eq!(height("paths.png"), CAPTION_PX + 2 * 120);
+        assert_eq!(height("states_obstacle.png"), CAPTION_PX + 4 * 120);
         let leftovers: Vec<_> = std::fs::read_dir(&dir)
             .unwrap()
             .filter_map(|e| e.ok())
@@ -504,6 +777,7 @@ mod tests {
             &MergeRoad::default(),
             &[],
             FigureSize::default(),
+            &caption(),
         );
         assert!(matches!(err, Err(PlotError::Empty(_))));
     }

@@ -3,6 +3,7 @@
 use sim::TimeSeriesRow;
 
 use crate::grid::{GridMetric, GridOutcome, PairedDifference};
+use crate::run_caption::RunCaption;
 use crate::summary::RunSummary;
 
 /// The `--csv` time series: a header and one line per vehicle per logged instant.
@@ -16,21 +17,66 @@ pub fn time_series_csv(rows: &[TimeSeriesRow]) -> String {
     text
 }
 
-/// The side-by-side table of `merge_sim compare`: the safety figures, then every vehicle's
-/// motion states and the paper's figures, one column per run.
-pub fn comparison_table(summaries: &[RunSummary]) -> String {
-    let mut out = String::new();
+/// The side-by-side table of `merge_sim compare`: its caption line (scenario, parameter set,
+/// instance, commit), then the safety figures, every vehicle's motion states and the paper's
+/// figures, one column per run.
+pub fn comparison_table(caption: &RunCaption, summaries: &[RunSummary]) -> String {
+    let rows = comparison_rows(summaries);
+    let mut out = format!("{}\n", caption.line());
     out.push_str(&format!("{:<28}", "metric"));
     for s in summaries {
         out.push_str(&format!("{:>13}", s.planner));
     }
     out.push('\n');
-    let mut row = |label: &str, value: &dyn Fn(&RunSummary) -> String| {
+    for (label, values) in rows {
         out.push_str(&format!("{label:<28}"));
-        for s in summaries {
-            out.push_str(&format!("{:>13}", value(s)));
+        for value in values {
+            out.push_str(&format!("{value:>13}"));
         }
         out.push('\n');
+    }
+    out
+}
+
+/// The same table in Markdown (`merge_sim compare --markdown`): the caption as a paragraph,
+/// then one row per figure, one column per run.
+pub fn comparison_markdown(caption: &RunCaption, summaries: &[RunSummary]) -> String {
+    let mut out = format!("{}\n\n| metric |", caption.line());
+    for s in summaries {
+        out.push_str(&format!(" {} |", s.planner));
+    }
+    out.push_str("\n|---|");
+    for _ in summaries {
+        out.push_str("---:|");
+    }
+    out.push('\n');
+    for (label, values) in comparison_rows(summaries) {
+        out.push_str(&format!("| {} |", label.replace('|', "\\|")));
+        for value in values {
+            out.push_str(&format!(" {} |", value.replace('|', "\\|")));
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// The JSON of `merge_sim compare --json`: the caption's fields, then the runs' summaries.
+pub fn comparison_json(caption: &RunCaption, summaries: &[RunSummary]) -> serde_json::Value {
+    serde_json::json!({
+        "scenario": caption.scenario,
+        "params": caption.params,
+        "seed": caption.seed.map(|s| s.to_string()),
+        "commit": caption.commit,
+        "caption": caption.line(),
+        "runs": summaries,
+    })
+}
+
+/// The rows of the comparison: (label, one value per run).
+fn comparison_rows(summaries: &[RunSummary]) -> Vec<(String, Vec<String>)> {
+    let mut rows: Vec<(String, Vec<String>)> = Vec::new();
+    let mut row = |label: &str, value: &dyn Fn(&RunSummary) -> String| {
+        rows.push((label.to_string(), summaries.iter().map(value).collect()));
     };
     row("collisions", &|s| s.collisions.to_string());
     row("min gap m", &|s| {
@@ -106,7 +152,7 @@ pub fn comparison_table(summaries: &[RunSummary]) -> String {
             opt(paper(s).and_then(|p| p.divider_crossing).map(|c| c.x_m), 1)
         });
     }
-    out
+    rows
 }
 
 /// The grid's table: per cell and planner, the mean of its peak yaw rate and of its merge-zone
@@ -218,4 +264,36 @@ pub fn study_table(outcome: &GridOutcome) -> String {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn caption() -> RunCaption {
+        RunCaption {
+            scenario: "dense_merge".into(),
+            params: "custom (paper + [sim.planner] substeps)".into(),
+            seed: Some(18_446_744_073_709_551_615),
+            commit: "0123456789ab".into(),
+        }
+    }
+
+    #[test]
+    fn every_comparison_output_opens_with_the_caption() {
+        let line = caption().line();
+        let text = comparison_table(&caption(), &[]);
+        assert_eq!(text.lines().next(), Some(line.as_str()));
+        assert!(text.lines().nth(1).is_some_and(|l| l.starts_with("metric")));
+        let markdown = comparison_markdown(&caption(), &[]);
+        assert_eq!(markdown.lines().next(), Some(line.as_str()));
+        assert!(markdown.contains("| metric |"), "{markdown}");
+        let json = comparison_json(&caption(), &[]);
+        assert_eq!(json["scenario"], "dense_merge");
+        assert_eq!(json["params"], "custom (paper + [sim.planner] substeps)");
+        assert_eq!(json["seed"], "18446744073709551615");
+        assert_eq!(json["commit"], "0123456789ab");
+        assert_eq!(json["caption"], line.as_str());
+        assert!(json["runs"].as_array().is_some_and(Vec::is_empty));
+    }
 }

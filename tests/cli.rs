@@ -445,3 +445,37 @@ fn a_large_recording_is_announced_before_it_is_written() {
         .unwrap();
     assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
 }
+
+#[test]
+fn compare_outputs_name_the_scenario_parameter_set_and_commit() {
+    let dir = scratch("compare_caption");
+    let (json, markdown) = (dir.join("cmp.json"), dir.join("cmp.md"));
+    let out = merge_sim(&[
+        "compare",
+        "--params",
+        "paper",
+        "--planners",
+        "pf-cs,pf-iso",
+        "--json",
+        json.to_str().unwrap(),
+        "--markdown",
+        markdown.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let commit = mergesim::build_info::short_commit();
+    let caption = format!("scenario urgent_merge · parameters paper · nominal · mergesim {commit}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(stdout.lines().next(), Some(caption.as_str()), "{stdout}");
+    let md = std::fs::read_to_string(&markdown).unwrap();
+    assert_eq!(md.lines().next(), Some(caption.as_str()), "{md}");
+    assert!(md.contains("| metric | pf-cs | pf-iso |"), "{md}");
+    let value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(value["scenario"], "urgent_merge");
+    assert_eq!(value["params"], "paper");
+    assert_eq!(value["commit"], commit.as_str());
+    assert_eq!(value["caption"], caption.as_str());
+    let runs = value["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    assert_eq!(runs[1]["planner"], "pf-iso");
+}

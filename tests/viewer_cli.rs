@@ -1,5 +1,5 @@
-//! `merge_sim run --gif` and `--follow` as a user runs them: the animation's frames and size,
-//! the vehicles in it, and bad input refused with exit code 2 before any work.
+//! `merge_sim run --gif`, `--gif-view` and `--follow` as a user runs them: the animation's
+//! frames and size, the vehicles in it, and bad input refused with exit code 2 before any work.
 
 mod common;
 
@@ -25,6 +25,98 @@ fn decode_gif(path: &Path) -> (usize, u16, u16, Vec<u16>, Vec<u8>) {
         delays.push(frame.delay);
     }
     (frames, w, h, delays, first)
+}
+
+/// Every frame of a GIF as RGBA, and its size.
+fn decode_frames(path: &Path) -> (u16, u16, Vec<Vec<u8>>) {
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let file = std::fs::File::open(path).unwrap();
+    let mut decoder = options.read_info(file).unwrap();
+    let (w, h) = (decoder.width(), decoder.height());
+    let mut frames = Vec::new();
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        assert_eq!((frame.width, frame.height), (w, h), "a partial frame");
+        frames.push(frame.buffer.to_vec());
+    }
+    (w, h, frames)
+}
+
+/// Which of the first `n` vehicles' colours (by id) a frame shows.
+fn vehicles_shown(frame: &[u8], n: u32) -> Vec<bool> {
+    (0..n)
+        .map(|id| {
+            let rgb = mergesim::sim::recording::vehicle_color(id);
+            frame.chunks(4).any(|p| p[..3] == rgb)
+        })
+        .collect()
+}
+
+#[test]
+fn the_road_view_is_the_default_beyond_two_vehicles_and_shows_every_one_in_every_frame() {
+    let dir = scratch("gif_road_view");
+    let road = dir.join("road.gif");
+    let follow = dir.join("follow.gif");
+    // dense_merge: six vehicles, 30 s.
+    for (path, extra) in [(&road, &[][..]), (&follow, &["--gif-view", "follow"][..])] {
+        let mut args = vec![
+            "run",
+            "--scenario",
+            "dense_merge",
+            "--no-rrd",
+            "--quiet",
+            "--gif",
+            path.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let out = merge_sim(&args);
+        assert!(out.status.success(), "{extra:?}: {}", stderr(&out));
+    }
+    let (w, h, frames) = decode_frames(&road);
+    assert_eq!(frames.len(), 300);
+    assert_eq!(w, 800);
+    for (k, frame) in frames.iter().enumerate() {
+        let shown = vehicles_shown(frame, 6);
+        assert!(
+            shown.iter().all(|&s| s),
+            "road view, frame {k}: vehicles shown {shown:?}"
+        );
+    }
+    // `follow` keeps the window of before: its size, and cars leave it.
+    let (fw, fh, follow_frames) = decode_frames(&follow);
+    assert_eq!((fw, fh), (800, 132));
+    assert_ne!(h, fh);
+    assert_eq!(follow_frames.len(), 300);
+    let incomplete = follow_frames
+        .iter()
+        .filter(|f| !vehicles_shown(f, 6).iter().all(|&s| s))
+        .count();
+    assert!(
+        incomplete > 0,
+        "the follow window showed every car in every frame"
+    );
+    // The followed vehicle (the scenario's first, upper1) is in every frame of it.
+    assert!(follow_frames.iter().all(|f| vehicles_shown(f, 1)[0]));
+}
+
+#[test]
+fn a_bad_gif_view_is_refused_before_the_run() {
+    let dir = scratch("gif_bad_view");
+    let gif = dir.join("x.gif");
+    let out = merge_sim(&[
+        "run",
+        "--no-rrd",
+        "--gif",
+        gif.to_str().unwrap(),
+        "--gif-view",
+        "sideways",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--gif-view"), "{}", stderr(&out));
+    assert!(!gif.exists());
+    // Without --gif it is a usage error too.
+    let out = merge_sim(&["run", "--no-rrd", "--gif-view", "road"]);
+    assert_eq!(out.status.code(), Some(2));
 }
 
 #[test]

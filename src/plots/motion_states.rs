@@ -4,37 +4,20 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::legend::{LegendEntry, Mark, split_for_legend};
 use super::{
-    DrawResult, PlannerSeries, collision_marks, font, padded_range, planner_color, planner_stroke,
+    PanelLayout, PlannerSeries, collision_marks, font, padded_range, panel_layout, planner_color,
+    planner_stroke,
 };
 use sim::TimeSeriesRow;
 
-/// The legend box of one panel, in the same style on every figure.
-pub(super) fn draw_legend<'a, DB, CT>(
-    chart: &mut ChartContext<'a, DB, CT>,
-    position: SeriesLabelPosition,
-) -> Result<(), String>
-where
-    DB: DrawingBackend + 'a,
-    DB::ErrorType: 'static,
-    CT: CoordTranslate,
-{
-    chart
-        .configure_series_labels()
-        .position(position)
-        .label_font(font(14))
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| e.to_string())
-}
-
-/// Fig. 4: sideslip, yaw, yaw rate and speed of `vehicle` over time, one line per planner.
+/// Fig. 4: sideslip, yaw, yaw rate and speed of `vehicle` over time, one line per planner;
+/// each panel's legend right of its chart. Returns where each panel was drawn.
 pub(super) fn draw_states(
     area: &DrawingArea<BitMapBackend<'_>, Shift>,
     series: &[PlannerSeries<'_>],
     vehicle: &str,
-) -> DrawResult {
+) -> Result<Vec<PanelLayout>, String> {
     type Getter = fn(&TimeSeriesRow) -> f64;
     let quantities: [(&str, Getter, f64); 4] = [
         ("sideslip β (rad)", |r| r.sideslip_rad, 0.002),
@@ -47,7 +30,30 @@ pub(super) fn draw_states(
         0.0,
         1.0,
     );
+    let style_of = |index: usize, planner: &str| {
+        planner_color(planner, index).stroke_width(planner_stroke(index, series.len()))
+    };
+    let mut entries: Vec<LegendEntry> = series
+        .iter()
+        .enumerate()
+        .map(|(index, s)| LegendEntry {
+            label: s.planner.to_string(),
+            mark: Mark::Line(style_of(index, s.planner)),
+        })
+        .collect();
+    let crashed = series.iter().any(|s| {
+        collision_marks(s.rows, s.collisions)
+            .iter()
+            .any(|m| m.1 == vehicle)
+    });
+    if crashed {
+        entries.push(LegendEntry {
+            label: "collision".into(),
+            mark: Mark::Dashed(RED.stroke_width(2)),
+        });
+    }
     let panels = area.split_evenly((quantities.len(), 1));
+    let mut layouts = Vec::new();
     for (panel, (label, get, min_span)) in panels.iter().zip(quantities) {
         let y_range = padded_range(
             series
@@ -56,7 +62,8 @@ pub(super) fn draw_states(
             0.05,
             min_span,
         );
-        let mut chart = ChartBuilder::on(panel)
+        let (chart_area, legend_area) = split_for_legend(panel, &entries);
+        let mut chart = ChartBuilder::on(&chart_area)
             .caption(format!("{vehicle}: {label}"), font(18))
             .margin(8)
             .margin_right(30)
@@ -73,8 +80,6 @@ pub(super) fn draw_states(
             .draw()
             .map_err(|e| e.to_string())?;
         for (index, s) in series.iter().enumerate() {
-            let color = planner_color(s.planner, index);
-            let style = color.stroke_width(planner_stroke(index, series.len()));
             let points: Vec<(f64, f64)> = s
                 .rows
                 .iter()
@@ -82,14 +87,11 @@ pub(super) fn draw_states(
                 .map(|r| (r.t_s, get(r)))
                 .collect();
             chart
-                .draw_series(LineSeries::new(points, style))
-                .map_err(|e| e.to_string())?
-                .label(s.planner.to_string())
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
+                .draw_series(LineSeries::new(points, style_of(index, s.planner)))
+                .map_err(|e| e.to_string())?;
         }
         // Collisions of this vehicle: a vertical red line in the planner's run.
         let y = chart.y_range();
-        let mut labelled = false;
         for s in series {
             for (t, _, _, _) in collision_marks(s.rows, s.collisions)
                 .into_iter()
@@ -97,16 +99,10 @@ pub(super) fn draw_states(
             {
                 let line =
                     DashedLineSeries::new([(t, y.start), (t, y.end)], 6, 4, RED.stroke_width(2));
-                let anchor = chart.draw_series(line).map_err(|e| e.to_string())?;
-                if !labelled {
-                    labelled = true;
-                    anchor.label("collision").legend(|(x, y)| {
-                        PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2))
-                    });
-                }
+                chart.draw_series(line).map_err(|e| e.to_string())?;
             }
         }
-        draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
+        layouts.push(panel_layout(&chart, &legend_area, &entries)?);
     }
-    Ok(())
+    Ok(layouts)
 }

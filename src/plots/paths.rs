@@ -4,27 +4,54 @@ use planner::MergeRoad;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::motion_states::draw_legend;
-use super::{DrawResult, PlannerSeries, collision_marks, font, padded_range, vehicle_rgb};
+use super::legend::{LegendEntry, Mark, split_for_legend};
+use super::{
+    PanelLayout, PlannerSeries, collision_marks, font, padded_range, panel_layout, vehicle_rgb,
+};
 
 /// Fig. 3: the road (edges, divider, merge section shaded) and each vehicle's path, one panel
-/// per planner; the first vehicle solid, the others dashed, in the recording's vehicle colours;
-/// collisions marked with red crosses.
+/// per planner; the first vehicle solid, the others dashed, in the vehicles' colours (the
+/// recording's and the GIF's, by id: `vehicles` is in id order); collisions marked with red
+/// crosses; each panel's legend right of its chart. Returns where each panel was drawn.
 pub(super) fn draw_paths(
     area: &DrawingArea<BitMapBackend<'_>, Shift>,
     road: &MergeRoad,
     series: &[PlannerSeries<'_>],
     vehicles: &[String],
-) -> DrawResult {
+) -> Result<Vec<PanelLayout>, String> {
     let x_range = padded_range(
         series.iter().flat_map(|s| s.rows.iter().map(|r| r.x_m)),
         0.01,
         10.0,
     );
     let y_range = (road.y_bottom_m - 0.5)..(road.y_upper_m() + 0.5);
+    let style_of = |k: usize| vehicle_rgb(k).stroke_width(2);
+    let mut entries: Vec<LegendEntry> = vehicles
+        .iter()
+        .enumerate()
+        .map(|(k, vehicle)| LegendEntry {
+            label: vehicle.clone(),
+            mark: if k == 0 {
+                Mark::Line(style_of(k))
+            } else {
+                Mark::Dashed(style_of(k))
+            },
+        })
+        .collect();
+    if series
+        .iter()
+        .any(|s| !collision_marks(s.rows, s.collisions).is_empty())
+    {
+        entries.push(LegendEntry {
+            label: "collision".into(),
+            mark: Mark::Cross,
+        });
+    }
     let panels = area.split_evenly((series.len(), 1));
+    let mut layouts = Vec::new();
     for (panel, s) in panels.iter().zip(series) {
-        let mut chart = ChartBuilder::on(panel)
+        let (chart_area, legend_area) = split_for_legend(panel, &entries);
+        let mut chart = ChartBuilder::on(&chart_area)
             .caption(format!("{}: paths", s.planner), font(20))
             .margin(8)
             .margin_right(30)
@@ -74,26 +101,21 @@ pub(super) fn draw_paths(
             ))
             .map_err(|e| e.to_string())?;
         for (k, vehicle) in vehicles.iter().enumerate() {
-            let color = vehicle_rgb(k);
             let points: Vec<(f64, f64)> = s
                 .rows
                 .iter()
                 .filter(|r| r.vehicle == *vehicle)
                 .map(|r| (r.x_m, r.y_m))
                 .collect();
-            let style = color.stroke_width(2);
-            let anchor = if k == 0 {
+            if k == 0 {
                 chart
-                    .draw_series(LineSeries::new(points, style))
-                    .map_err(|e| e.to_string())?
+                    .draw_series(LineSeries::new(points, style_of(k)))
+                    .map_err(|e| e.to_string())?;
             } else {
                 chart
-                    .draw_series(DashedLineSeries::new(points, 10, 5, style))
-                    .map_err(|e| e.to_string())?
-            };
-            anchor
-                .label(vehicle.clone())
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
+                    .draw_series(DashedLineSeries::new(points, 10, 5, style_of(k)))
+                    .map_err(|e| e.to_string())?;
+            }
         }
         // Collisions: a red cross at each vehicle involved, where it was.
         let marks = collision_marks(s.rows, s.collisions);
@@ -104,11 +126,9 @@ pub(super) fn draw_paths(
                         .iter()
                         .map(|m| Cross::new((m.2, m.3), 7, RED.stroke_width(3))),
                 )
-                .map_err(|e| e.to_string())?
-                .label("collision")
-                .legend(|(x, y)| Cross::new((x + 10, y), 5, RED.stroke_width(2)));
+                .map_err(|e| e.to_string())?;
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+        layouts.push(panel_layout(&chart, &legend_area, &entries)?);
     }
-    Ok(())
+    Ok(layouts)
 }

@@ -33,9 +33,44 @@ const VIRIDIS: [[u8; 3]; 9] = [
     [253, 231, 37],
 ];
 
-/// The palette colour of vehicle `id`.
+/// The one colour of vehicle `id` (its position in the scenario's vehicle list), used by every
+/// output that draws vehicles: the Rerun recording, the PNG figures (`merge_sim compare
+/// --plots`) and the GIF (`merge_sim run --gif`), so a vehicle has the same RGB in all three.
+///
+/// Ids 0 to 7 take [`VEHICLE_PALETTE`] (the paper's green ego and blue obstacle first); later
+/// ids take hues spaced by the golden angle, at three lightness levels, so no two ids below
+/// [`DISTINCT_VEHICLE_COLORS`] share a colour and none is a grey (the road's colours).
 pub fn vehicle_color(id: VehicleId) -> [u8; 3] {
-    VEHICLE_PALETTE[(id as usize) % VEHICLE_PALETTE.len()]
+    let index = id as usize;
+    if let Some(color) = VEHICLE_PALETTE.get(index) {
+        return *color;
+    }
+    let k = (index - VEHICLE_PALETTE.len()) as f64;
+    // Golden-ratio steps around the hue circle; the lightness cycles every 7 ids.
+    let hue = (0.13 + k * 0.618_033_988_749_895).fract();
+    let lightness = [0.50, 0.36, 0.64][((index - VEHICLE_PALETTE.len()) / 7) % 3];
+    hsl_to_rgb(hue, 0.75, lightness)
+}
+
+/// Ids up to this many get pairwise distinct colours from [`vehicle_color`] (the largest
+/// scenario has 200 vehicles).
+pub const DISTINCT_VEHICLE_COLORS: u32 = 200;
+
+/// An HSL colour (each in [0, 1]) as RGB.
+fn hsl_to_rgb(hue: f64, saturation: f64, lightness: f64) -> [u8; 3] {
+    let c = (1.0 - (2.0 * lightness - 1.0).abs()) * saturation;
+    let h6 = hue * 6.0;
+    let x = c * (1.0 - (h6 % 2.0 - 1.0).abs());
+    let (r, g, b) = match h6 as u32 {
+        0 => (c, x, 0.0),
+        1 => (x, c, 0.0),
+        2 => (0.0, c, x),
+        3 => (0.0, x, c),
+        4 => (x, 0.0, c),
+        _ => (c, 0.0, x),
+    };
+    let m = lightness - 0.5 * c;
+    [r, g, b].map(|v| ((v + m) * 255.0).round().clamp(0.0, 255.0) as u8)
 }
 
 /// Viridis colour of `t` in [0, 1] (clamped).
@@ -137,6 +172,22 @@ pub(crate) fn y_up_quaternion() -> Quaternion {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn vehicle_colours_are_distinct_and_not_grey() {
+        assert_eq!(vehicle_color(0), [44, 160, 44]);
+        assert_eq!(vehicle_color(1), [31, 119, 180]);
+        let colors: Vec<[u8; 3]> = (0..DISTINCT_VEHICLE_COLORS).map(vehicle_color).collect();
+        for (i, a) in colors.iter().enumerate() {
+            let spread = a.iter().max().unwrap() - a.iter().min().unwrap();
+            assert!(spread >= 40, "vehicle {i}: {a:?} is nearly grey");
+            for (j, b) in colors.iter().enumerate().take(i) {
+                assert_ne!(a, b, "vehicles {i} and {j}");
+            }
+        }
+        // The same id gives the same colour, whoever asks.
+        assert_eq!(vehicle_color(37), vehicle_color(37));
+    }
 
     #[test]
     fn viridis_hits_its_control_points_and_clamps() {

@@ -300,4 +300,7 @@ fn check_finite(call: &'static str, what: &str, values: &[f64]) -> Result<(), Re
     Ok(())
 }
 
-pub use colors::{entity_part, field_scale_ticks, normalize_field, vehicle_color, viridis};
+pub use colors::{
+    DISTINCT_VEHICLE_COLORS, entity_part, field_scale_ticks, normalize_field, vehicle_color,
+    viridis,
+};

@@ -98,8 +98,8 @@ pub(crate) struct RunArgs {
     /// the run.
     #[arg(long, value_name = "NAME")]
     pub(crate) follow: Option<String>,
-    /// Write a top-down animated GIF of the run here (drawn on the CPU: no GPU or display),
-    /// following --follow.
+    /// Write a top-down animated GIF of the run here (drawn on the CPU: no GPU or display):
+    /// the whole road or a window following --follow (--gif-view).
     #[arg(long, value_name = "PATH")]
     pub(crate) gif: Option<PathBuf>,
     /// Frames per second of the GIF, of simulated time and of playback (real time).
@@ -108,6 +108,12 @@ pub(crate) struct RunArgs {
     /// Width of the GIF (pixels); the height follows from the road's width.
     #[arg(long, value_name = "PX", default_value_t = 800, requires = "gif")]
     pub(crate) gif_width: u32,
+    /// What the GIF shows: `road`, the whole road with every vehicle in every frame (scaled to
+    /// the width, across stretched so the lanes stay visible), or `follow`, a window of 30 m
+    /// behind to 50 m ahead of --follow [default: road when more than two vehicles run, else
+    /// follow].
+    #[arg(long, value_name = "VIEW", value_enum, requires = "gif")]
+    pub(crate) gif_view: Option<GifViewArg>,
     /// Write the JSON summary here.
     #[arg(long, value_name = "PATH")]
     pub(crate) json: Option<PathBuf>,
@@ -140,6 +146,24 @@ impl RunArgs {
     }
 }
 
+/// `run --gif-view`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum GifViewArg {
+    /// The whole road with every vehicle.
+    Road,
+    /// A window around the followed vehicle.
+    Follow,
+}
+
+impl From<GifViewArg> for mergesim::animation::GifView {
+    fn from(view: GifViewArg) -> Self {
+        match view {
+            GifViewArg::Road => Self::Road,
+            GifViewArg::Follow => Self::Follow,
+        }
+    }
+}
+
 #[derive(Args, Debug)]
 pub(crate) struct CompareArgs {
     #[command(flatten)]
@@ -153,9 +177,13 @@ pub(crate) struct CompareArgs {
     /// hex); without it the nominal scenario.
     #[arg(long, value_name = "N", value_parser = parse_seed)]
     pub(crate) seed: Option<u64>,
-    /// Write the JSON summaries (an array) here.
+    /// Write the JSON here: the caption's scenario, params, seed and commit, then the runs'
+    /// summaries under `runs`.
     #[arg(long, value_name = "PATH")]
     pub(crate) json: Option<PathBuf>,
+    /// Write the table as Markdown here (its caption line first).
+    #[arg(long, value_name = "PATH")]
+    pub(crate) markdown: Option<PathBuf>,
     /// Write figures into this existing folder: paths.png (both vehicles' paths per planner,
     /// the paper's Fig. 3), states_<vehicle>.png (sideslip, yaw, yaw rate, speed over time per
     /// planner; states_obstacle.png is the paper's Fig. 4) and time_series.csv (their data).

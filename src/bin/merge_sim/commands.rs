@@ -5,7 +5,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow};
 use mergesim::output::{check_distinct, check_output_path, write_atomically};
-use mergesim::report::{comparison_table, grid_table, study_table, time_series_csv};
+use mergesim::report::{
+    comparison_json, comparison_markdown, comparison_table, grid_table, study_table,
+    time_series_csv,
+};
+use mergesim::run_caption::RunCaption;
 use scenarios::Scenario;
 use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
 
@@ -94,6 +98,10 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
     let gif_params = mergesim::animation::GifParams {
         fps: args.gif_fps,
         width_px: args.gif_width,
+        view: args.gif_view.map_or_else(
+            || mergesim::animation::GifView::default_for(scenario.vehicles.len()),
+            Into::into,
+        ),
         ..mergesim::animation::GifParams::default()
     };
     if args.gif.is_some() {
@@ -285,9 +293,13 @@ fn write_run_gif(
 pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(), Failure> {
     let scenario = load_scenario(&args.source.scenario, args.source.params)?;
     check_outputs(
-        &[(args.json.as_deref(), "--json")],
+        &[
+            (args.json.as_deref(), "--json"),
+            (args.markdown.as_deref(), "--markdown"),
+        ],
         &scenario_file(&args.source.scenario),
     )?;
+    let caption = RunCaption::of_scenario(&scenario, args.seed);
     if let Some(dir) = &args.plots {
         let vehicles: Vec<&str> = scenario.vehicles.iter().map(|v| v.name.as_str()).collect();
         mergesim::plots::check_plot_dir(dir, &vehicles).map_err(|e| input(anyhow!(e)))?;
@@ -309,10 +321,16 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
         time_series.push(finished.outcome.time_series);
         collisions.push(finished.outcome.safety.collisions);
     }
-    out!("{}", comparison_table(&summaries));
+    out!("{}", comparison_table(&caption, &summaries));
     if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&summaries).map_err(run_failure)?;
+        let text = serde_json::to_string_pretty(&comparison_json(&caption, &summaries))
+            .map_err(run_failure)?;
         write_atomically(path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))
+            .map_err(run_failure)?;
+    }
+    if let Some(path) = &args.markdown {
+        write_atomically(path, comparison_markdown(&caption, &summaries).as_bytes())
             .with_context(|| format!("cannot write {}", path.display()))
             .map_err(run_failure)?;
     }
@@ -333,6 +351,7 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
             road,
             &series,
             mergesim::plots::FigureSize::default(),
+            &caption,
         )
         .map_err(run_failure)?;
         for path in written {
@@ -442,6 +461,7 @@ pub(crate) fn cmd_grid(args: &GridArgs, interrupt: &Interrupt) -> Result<(), Fai
             ..GridAxes::default()
         }
     };
+    let caption = RunCaption::of_scenario(&scenario, None);
     let plan = GridPlan {
         axes,
         scenario,
@@ -479,8 +499,14 @@ pub(crate) fn cmd_grid(args: &GridArgs, interrupt: &Interrupt) -> Result<(), Fai
         write_output(path, &text)?;
     }
     if let Some(path) = &args.plot {
-        mergesim::grid_plot::write_grid_png(path, &outcome, &args.vehicle, GridMetric::PeakYawRate)
-            .map_err(run_failure)?;
+        mergesim::grid_plot::write_grid_png(
+            path,
+            &outcome,
+            &args.vehicle,
+            GridMetric::PeakYawRate,
+            &caption,
+        )
+        .map_err(run_failure)?;
     }
     if !args.quiet {
         out!("{}", grid_table(&outcome, &args.vehicle));

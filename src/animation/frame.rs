@@ -1,0 +1,261 @@
+//! One frame of the animation: where road coordinates fall in the picture (the follow window or
+//! the whole road) and the drawing of the road, the vehicles and the header.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use sim::TimeSeriesRow;
+use sim::recording::vehicle_color;
+use sim::safety::CollisionEvent;
+
+use super::{GifParams, GifVehicle, GifView};
+use crate::plots::font;
+
+/// Height of the header line (pixels).
+pub(super) const HEADER_PX: u32 = 22;
+
+/// Height of the bands above and below the road that hold the vehicles' names in the road view
+/// (pixels).
+const LABEL_BAND_PX: u32 = 15;
+
+/// Lateral scale of the road view (pixels per metre) when the road's length alone would make
+/// the lanes thinner: a 3.5 m lane is 14 px high.
+const ROAD_VIEW_PX_PER_M_ACROSS: f64 = 4.0;
+
+/// Smallest drawn footprint (pixels along, across), so a car stays visible on a long road.
+const MIN_FOOTPRINT_PX: (f64, f64) = (8.0, 5.0);
+
+/// How road coordinates map to a frame's pixels: X to the right, Y up.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameGeometry {
+    /// Road X at the picture's left edge (m).
+    pub x0_m: f64,
+    /// Road Y at the top of the road area (m).
+    pub y_top_m: f64,
+    /// Pixels per metre along X.
+    pub px_per_m_x: f64,
+    /// Pixels per metre along Y: the same as along X in the follow view; in the road view of a
+    /// long road larger, so the lanes stay visible (the header says by how much).
+    pub px_per_m_y: f64,
+    /// Top of the road area (pixels).
+    pub top_px: u32,
+    /// Picture size (pixels).
+    pub size_px: (u32, u32),
+}
+
+impl FrameGeometry {
+    /// The follow view: [`GifParams::behind_m`] behind `x_center_m` to [`GifParams::ahead_m`]
+    /// ahead, the road's whole width with [`GifParams::margin_m`] beside it, one scale.
+    pub fn follow(road: &sim::MergeRoad, params: &GifParams, x_center_m: f64) -> Self {
+        let px_per_m = f64::from(params.width_px) / (params.behind_m + params.ahead_m);
+        let road_px = ((road.y_upper_m() - road.y_bottom_m + 2.0 * params.margin_m) * px_per_m)
+            .ceil()
+            .clamp(16.0, 4000.0);
+        Self {
+            x0_m: x_center_m - params.behind_m,
+            y_top_m: road.y_upper_m() + params.margin_m,
+            px_per_m_x: px_per_m,
+            px_per_m_y: px_per_m,
+            top_px: HEADER_PX,
+            size_px: (params.width_px, HEADER_PX + road_px as u32),
+        }
+    }
+
+    /// The road view: the whole road, and every position in `rows`, across the picture's
+    /// width; the vehicles' names in a band above and below the road.
+    pub fn whole_road(road: &sim::MergeRoad, params: &GifParams, rows: &[TimeSeriesRow]) -> Self {
+        let (mut lo, mut hi) = (road.start_x_m, road.end_x_m);
+        for r in rows.iter().filter(|r| r.x_m.is_finite()) {
+            lo = lo.min(r.x_m - 5.0);
+            hi = hi.max(r.x_m + 5.0);
+        }
+        let span = (hi - lo).max(1.0);
+        let pad = 0.01 * span;
+        let px_per_m_x = f64::from(params.width_px) / (span + 2.0 * pad);
+        let px_per_m_y = px_per_m_x.max(ROAD_VIEW_PX_PER_M_ACROSS);
+        let road_px = ((road.y_upper_m() - road.y_bottom_m + 2.0 * params.margin_m) * px_per_m_y)
+            .ceil()
+            .clamp(16.0, 4000.0);
+        Self {
+            x0_m: lo - pad,
+            y_top_m: road.y_upper_m() + params.margin_m,
+            px_per_m_x,
+            px_per_m_y,
+            top_px: HEADER_PX + LABEL_BAND_PX,
+            size_px: (
+                params.width_px,
+                HEADER_PX + 2 * LABEL_BAND_PX + road_px as u32,
+            ),
+        }
+    }
+
+    /// The pixel of road point (x, y).
+    pub fn to_px(&self, x_m: f64, y_m: f64) -> (i32, i32) {
+        (
+            ((x_m - self.x0_m) * self.px_per_m_x).round() as i32,
+            (f64::from(self.top_px) + (self.y_top_m - y_m) * self.px_per_m_y).round() as i32,
+        )
+    }
+}
+
+/// The corners of a footprint centred at (x, y) with heading `yaw`.
+pub(super) fn footprint(x: f64, y: f64, yaw: f64, length: f64, width: f64) -> [(f64, f64); 4] {
+    let (s, c) = yaw.sin_cos();
+    let (hl, hw) = (0.5 * length, 0.5 * width);
+    [(hl, hw), (-hl, hw), (-hl, -hw), (hl, -hw)]
+        .map(|(dx, dy)| (x + c * dx - s * dy, y + s * dx + c * dy))
+}
+
+/// What one frame shows besides its instant.
+pub(super) struct FrameScene<'a> {
+    pub(super) road: &'a sim::MergeRoad,
+    pub(super) vehicles: &'a [GifVehicle],
+    pub(super) collisions: &'a [CollisionEvent],
+    pub(super) follow: &'a str,
+    pub(super) title: &'a str,
+    pub(super) view: GifView,
+}
+
+/// Draws the frame of `instant` with `geometry`.
+pub(super) fn draw_frame(
+    root: &DrawingArea<BitMapBackend<'_>, Shift>,
+    scene: &FrameScene<'_>,
+    instant: &[TimeSeriesRow],
+    geometry: &FrameGeometry,
+) -> Result<(), String> {
+    let FrameScene {
+        road,
+        vehicles,
+        collisions,
+        follow,
+        title,
+        view,
+    } = *scene;
+    let e = |err: &dyn std::fmt::Display| err.to_string();
+    let (w, _) = geometry.size_px;
+    root.fill(&RGBColor(40, 40, 44)).map_err(|x| e(&x))?;
+    let t_s = instant.first().map_or(0.0, |r| r.t_s);
+    let followed = instant.iter().find(|r| r.vehicle == follow);
+    let to_px = |x: f64, y: f64| geometry.to_px(x, y);
+    // Merge section.
+    let (mx0, my0) = to_px(road.merge_start_x_m, road.y_upper_m());
+    let (mx1, my1) = to_px(road.merge_end_x_m, road.y_bottom_m);
+    root.draw(&Rectangle::new(
+        [(mx0, my0), (mx1, my1)],
+        RGBColor(75, 58, 38).filled(),
+    ))
+    .map_err(|x| e(&x))?;
+    // Edges and divider.
+    let line = |pts: &[[f64; 2]]| pts.iter().map(|p| to_px(p[0], p[1])).collect::<Vec<_>>();
+    for edge in [road.upper_edge_polyline(), road.lower_edge_polyline()] {
+        root.draw(&PathElement::new(
+            line(&edge),
+            ShapeStyle::from(&RGBColor(230, 230, 230)).stroke_width(2),
+        ))
+        .map_err(|x| e(&x))?;
+    }
+    let divider = [
+        [road.start_x_m, road.y_lane_m()],
+        [road.merge_end_x_m, road.y_lane_m()],
+    ];
+    root.draw(&PathElement::new(
+        line(&divider),
+        ShapeStyle::from(&RGBColor(240, 200, 60)).stroke_width(1),
+    ))
+    .map_err(|x| e(&x))?;
+    // Vehicles: footprints first, names on top.
+    let mut labels = Vec::new();
+    for row in instant {
+        let Some(v) = vehicles.iter().find(|v| v.name == row.vehicle) else {
+            continue;
+        };
+        if ![row.x_m, row.y_m, row.yaw_rad]
+            .iter()
+            .all(|c| c.is_finite())
+        {
+            continue;
+        }
+        let length_m = v.length_m.max(MIN_FOOTPRINT_PX.0 / geometry.px_per_m_x);
+        let width_m = v.width_m.max(MIN_FOOTPRINT_PX.1 / geometry.px_per_m_y);
+        let corners =
+            footprint(row.x_m, row.y_m, row.yaw_rad, length_m, width_m).map(|(x, y)| to_px(x, y));
+        // Outside the window: not drawn (its label would be pinned to the picture's edge).
+        if corners.iter().all(|&(x, _)| x < 0) || corners.iter().all(|&(x, _)| x >= w as i32) {
+            continue;
+        }
+        let [r, g, b] = vehicle_color(v.id);
+        let fill = Polygon::new(corners.to_vec(), RGBColor(r, g, b).filled());
+        let crashed = collisions
+            .iter()
+            .any(|c| c.t_s <= t_s + 1e-9 && c.involves(v.id));
+        let mut outline = corners.to_vec();
+        outline.push(corners[0]);
+        let outline = PathElement::new(
+            outline,
+            ShapeStyle::from(&RGBColor(255, 40, 40)).stroke_width(3),
+        );
+        // In the road view a car is a few pixels: its red outline goes under it, not over it.
+        if crashed && view == GifView::Road {
+            root.draw(&outline).map_err(|x| e(&x))?;
+        }
+        root.draw(&fill).map_err(|x| e(&x))?;
+        if crashed && view == GifView::Follow {
+            root.draw(&outline).map_err(|x| e(&x))?;
+        }
+        let position = match view {
+            GifView::Follow => {
+                let (lx, ly) = to_px(row.x_m - 0.5 * v.length_m, row.y_m + 0.5 * v.width_m);
+                (lx, ly - 13)
+            }
+            // Names in the bands: even ids above the road, odd ids below.
+            GifView::Road => {
+                let (lx, _) = to_px(row.x_m, row.y_m);
+                let y = if v.id % 2 == 0 {
+                    geometry.top_px as i32 - LABEL_BAND_PX as i32 + 1
+                } else {
+                    geometry.size_px.1 as i32 - LABEL_BAND_PX as i32 + 1
+                };
+                (lx - 4, y)
+            }
+        };
+        labels.push((v.name.clone(), position));
+    }
+    for (name, position) in labels {
+        root.draw(&Text::new(
+            name,
+            position,
+            font(12).color(&RGBColor(235, 235, 235)),
+        ))
+        .map_err(|x| e(&x))?;
+    }
+    // Header.
+    root.draw(&Rectangle::new(
+        [(0, 0), (w as i32, HEADER_PX as i32)],
+        RGBColor(20, 20, 22).filled(),
+    ))
+    .map_err(|x| e(&x))?;
+    let speed = followed.map_or(String::new(), |r| {
+        format!("  {follow} {:.1} m/s  x = {:.0} m", r.speed_mps, r.x_m)
+    });
+    let scale = match view {
+        GifView::Follow => String::new(),
+        GifView::Road => {
+            let stretch = geometry.px_per_m_y / geometry.px_per_m_x;
+            if stretch > 1.05 {
+                format!("  whole road (across ×{stretch:.0})")
+            } else {
+                "  whole road".into()
+            }
+        }
+    };
+    let crash = collisions
+        .iter()
+        .rfind(|c| c.t_s <= t_s + 1e-9)
+        .map_or(String::new(), |c| format!("  COLLISION at {:.2} s", c.t_s));
+    root.draw(&Text::new(
+        format!("{title}  t = {t_s:5.2} s{scale}{speed}{crash}"),
+        (6, 4),
+        font(14).color(&RGBColor(240, 240, 240)),
+    ))
+    .map_err(|x| e(&x))?;
+    Ok(())
+}
