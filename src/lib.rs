@@ -17,6 +17,7 @@ pub mod output;
 pub mod plots;
 pub mod report;
 pub mod scaling;
+pub mod study;
 pub mod summary;
 pub mod sweep;
 

@@ -26,6 +26,13 @@ def sweep(
 ) -> List[str]:
     """The JSONL rows of a paired sweep of the planners (none: the scenario's own)."""
 
+def study(
+    plan: str,
+    out: Optional[str] = None,
+    threads: Optional[int] = None,
+) -> str:
+    """The report (``report.json``) of the study plan at ``plan``, as JSON text."""
+
 def builtin_scenarios() -> List[str]:
     """Names of the built-in scenarios."""
 
