@@ -20,7 +20,7 @@ use mergesim_types::files::read_regular_text;
 use crate::args::{parse_shard, parse_threads};
 use crate::commands::progress_bar;
 use crate::signals::Interrupt;
-use crate::{Failure, input, interrupted, outln, run_failure};
+use crate::{Failure, input, interrupted, out, outln, run_failure};
 
 /// Longest rows file read back (`--resume`, `--merge`).
 const MAX_ROWS_BYTES: u64 = 1 << 30;
