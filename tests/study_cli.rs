@@ -329,3 +329,33 @@ fn study_help_explains_the_plan_format() {
         assert!(text.contains(needle), "help lacks {needle:?}");
     }
 }
+
+/// The example plan of the docs, as a user runs it (a copy, so the repository stays clean).
+#[test]
+fn the_example_plan_runs_and_reports() {
+    let dir = scratch("study_example");
+    let example = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs/studies/examples/urgent_merge_small.toml");
+    let plan = dir.join("urgent_merge_small.toml");
+    std::fs::copy(&example, &plan).unwrap();
+    let started = std::time::Instant::now();
+    let out = merge_sim(&["study", s(&plan)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report = dir.join("urgent_merge_small.report");
+    let md = read(&report.join("report.md"));
+    for section in [
+        "## Provenance",
+        "## Primary endpoint",
+        "## Secondary endpoints",
+        "## Collisions",
+        "## Figure",
+        "sim.planner.interaction_time_gap_s=3.0",
+    ] {
+        assert!(md.contains(section), "{section}");
+    }
+    assert_eq!(read(&report.join("rows.jsonl")).lines().count(), 40);
+    // Progress and the primary results on the terminal.
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("obstacle.max_abs_yaw_rate_radps"), "{stdout}");
+    eprintln!("example study: {:.1} s", started.elapsed().as_secs_f64());
+}
