@@ -12,6 +12,7 @@ pub mod exact_seed;
 pub mod experiment;
 pub mod grid;
 pub mod grid_plot;
+pub mod inference;
 pub mod limits;
 pub mod output;
 pub mod plots;
