@@ -25,7 +25,10 @@ use serde_json::Value;
 const REL: f64 = 1e-9;
 
 fn reference() -> Value {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/inference_reference.json");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/inference_reference.json"
+    );
     let text = std::fs::read_to_string(path).expect("the fixture is committed");
     serde_json::from_str(&text).expect("the fixture is JSON")
 }
@@ -58,7 +61,7 @@ fn table(v: &Value) -> Discordance {
 
 thread_local! {
     /// The largest relative difference seen per kind of figure (printed at the end).
-    static WORST: RefCell<BTreeMap<String, f64>> = RefCell::new(BTreeMap::new());
+    static WORST: RefCell<BTreeMap<String, (f64, String)>> = const { RefCell::new(BTreeMap::new()) };
 }
 
 /// `got` equals `expected` within `rel` relative (absolutely within `zero_abs` when the
@@ -76,8 +79,10 @@ fn check(kind: &str, label: &str, got: f64, expected: f64, rel: f64, zero_abs: f
     let err = (got - expected).abs() / expected.abs();
     WORST.with(|w| {
         let mut w = w.borrow_mut();
-        let worst = w.entry(kind.to_string()).or_insert(0.0);
-        *worst = worst.max(err);
+        let worst = w.entry(kind.to_string()).or_insert((0.0, String::new()));
+        if err > worst.0 {
+            *worst = (err, label.to_string());
+        }
     });
     assert!(
         err <= rel,
@@ -87,8 +92,8 @@ fn check(kind: &str, label: &str, got: f64, expected: f64, rel: f64, zero_abs: f
 
 fn print_worst() {
     WORST.with(|w| {
-        for (kind, err) in w.borrow().iter() {
-            println!("largest relative difference, {kind}: {err:.2e}");
+        for (kind, (err, label)) in w.borrow().iter() {
+            println!("largest relative difference, {kind}: {err:.2e} ({label})");
         }
     });
 }
@@ -100,28 +105,81 @@ fn distributions_match_scipy() {
     for e in d["student_t"].as_array().unwrap() {
         let (x, df) = (num(&e["x"]), num(&e["df"]));
         let label = format!("x={x} df={df}");
-        check("t cdf", &label, student_t_cdf(x, df), num(&e["cdf"]), REL, 1e-300);
-        check("t sf", &label, student_t_sf(x, df), num(&e["sf"]), REL, 1e-300);
+        check(
+            "t cdf",
+            &label,
+            student_t_cdf(x, df),
+            num(&e["cdf"]),
+            REL,
+            1e-300,
+        );
+        check(
+            "t sf",
+            &label,
+            student_t_sf(x, df),
+            num(&e["sf"]),
+            REL,
+            1e-300,
+        );
     }
     for e in d["student_t_quantile"].as_array().unwrap() {
         let (a, df) = (num(&e["upper_tail"]), num(&e["df"]));
         let label = format!("upper tail {a} df={df}");
-        check("t quantile", &label, student_t_upper_quantile(a, df), num(&e["quantile"]), REL, 0.0);
+        check(
+            "t quantile",
+            &label,
+            student_t_upper_quantile(a, df),
+            num(&e["quantile"]),
+            REL,
+            0.0,
+        );
     }
     for e in d["normal"].as_array().unwrap() {
         let x = num(&e["x"]);
         let label = format!("x={x}");
-        check("normal cdf", &label, normal_cdf(x), num(&e["cdf"]), REL, 1e-300);
-        check("normal sf", &label, normal_sf(x), num(&e["sf"]), REL, 1e-300);
+        check(
+            "normal cdf",
+            &label,
+            normal_cdf(x),
+            num(&e["cdf"]),
+            REL,
+            1e-300,
+        );
+        check(
+            "normal sf",
+            &label,
+            normal_sf(x),
+            num(&e["sf"]),
+            REL,
+            1e-300,
+        );
     }
     for e in d["normal_quantile"].as_array().unwrap() {
         let a = num(&e["upper_tail"]);
-        check("normal quantile", &format!("{a}"), normal_upper_quantile(a), num(&e["quantile"]), REL, 0.0);
+        check(
+            "normal quantile",
+            &format!("{a}"),
+            normal_upper_quantile(a),
+            num(&e["quantile"]),
+            REL,
+            0.0,
+        );
     }
     for e in d["binomial_cdf"].as_array().unwrap() {
-        let (k, n, p) = (e["k"].as_u64().unwrap(), e["n"].as_u64().unwrap(), num(&e["p"]));
+        let (k, n, p) = (
+            e["k"].as_u64().unwrap(),
+            e["n"].as_u64().unwrap(),
+            num(&e["p"]),
+        );
         let label = format!("k={k} n={n} p={p}");
-        check("binomial cdf", &label, binomial_cdf(k, n, p), num(&e["cdf"]), REL, 1e-300);
+        check(
+            "binomial cdf",
+            &label,
+            binomial_cdf(k, n, p),
+            num(&e["cdf"]),
+            REL,
+            1e-300,
+        );
     }
     print_worst();
 }
@@ -150,7 +208,14 @@ fn paired_t_matches_scipy_ttest_1samp() {
             assert_eq!((got.t, got.p_two_sided), (0.0, 1.0), "{label}");
         } else {
             check("t statistic", &label, got.t, num(&e["t"]), REL, 1e-15);
-            check("t-test p", &label, got.p_two_sided, num(&e["p_two_sided"]), REL, 1e-300);
+            check(
+                "t-test p",
+                &label,
+                got.p_two_sided,
+                num(&e["p_two_sided"]),
+                REL,
+                1e-300,
+            );
         }
     }
     print_worst();
@@ -173,7 +238,11 @@ fn wilcoxon_matches_scipy() {
             other => panic!("unknown method {other}"),
         };
         assert_eq!(got.method, method, "{name}");
-        assert_eq!(got.n_nonzero as u64, e["n_nonzero"].as_u64().unwrap(), "{name}");
+        assert_eq!(
+            got.n_nonzero as u64,
+            e["n_nonzero"].as_u64().unwrap(),
+            "{name}"
+        );
         // The statistic is a sum of half-integer ranks: exact.
         assert_eq!(got.statistic, num(&e["statistic"]), "{name}");
         if e["p_two_sided"].is_null() {
@@ -181,7 +250,14 @@ fn wilcoxon_matches_scipy() {
             assert_eq!(got.p_two_sided, 1.0, "{name}");
         } else {
             let kind = format!("wilcoxon p ({})", e["method"].as_str().unwrap());
-            check(&kind, name, got.p_two_sided, num(&e["p_two_sided"]), REL, 0.0);
+            check(
+                &kind,
+                name,
+                got.p_two_sided,
+                num(&e["p_two_sided"]),
+                REL,
+                0.0,
+            );
         }
     }
     print_worst();
@@ -192,7 +268,14 @@ fn exact_mcnemar_matches_statsmodels() {
     let r = reference();
     for e in r["mcnemar"].as_array().unwrap() {
         let name = e["table_name"].as_str().unwrap();
-        check("mcnemar p", name, mcnemar_exact(&table(&e["table"])), num(&e["p"]), REL, 0.0);
+        check(
+            "mcnemar p",
+            name,
+            mcnemar_exact(&table(&e["table"])),
+            num(&e["p"]),
+            REL,
+            0.0,
+        );
     }
     print_worst();
 }
@@ -207,9 +290,30 @@ fn newcombe_matches_the_published_formulas() {
         let label = format!("{name} at {confidence}");
         let got = newcombe_paired_difference(&table(&e["table"]), confidence).unwrap();
         assert_eq!(got.n, e["n"].as_u64().unwrap());
-        check("newcombe proportions", &label, got.first, num(&e["first"]), REL, 1e-15);
-        check("newcombe proportions", &label, got.second, num(&e["second"]), REL, 1e-15);
-        check("newcombe difference", &label, got.difference, num(&e["difference"]), REL, 1e-15);
+        check(
+            "newcombe proportions",
+            &label,
+            got.first,
+            num(&e["first"]),
+            REL,
+            1e-15,
+        );
+        check(
+            "newcombe proportions",
+            &label,
+            got.second,
+            num(&e["second"]),
+            REL,
+            1e-15,
+        );
+        check(
+            "newcombe difference",
+            &label,
+            got.difference,
+            num(&e["difference"]),
+            REL,
+            1e-15,
+        );
         // The independent Python implementation of the paper's formulas.
         let ci = numbers(&e["ci"]);
         check("newcombe ci (python)", &label, got.ci[0], ci[0], REL, 1e-15);
@@ -217,12 +321,29 @@ fn newcombe_matches_the_published_formulas() {
         // statsmodels, where phi = 0 (its independent-samples Newcombe interval).
         if !e["statsmodels_phi0_ci"].is_null() {
             let sm = numbers(&e["statsmodels_phi0_ci"]);
-            check("newcombe ci (statsmodels, phi 0)", &label, got.ci[0], sm[0], REL, 1e-15);
-            check("newcombe ci (statsmodels, phi 0)", &label, got.ci[1], sm[1], REL, 1e-15);
+            check(
+                "newcombe ci (statsmodels, phi 0)",
+                &label,
+                got.ci[0],
+                sm[0],
+                REL,
+                1e-15,
+            );
+            check(
+                "newcombe ci (statsmodels, phi 0)",
+                &label,
+                got.ci[1],
+                sm[1],
+                REL,
+                1e-15,
+            );
             checked_against_statsmodels += 1;
         }
     }
-    assert!(checked_against_statsmodels >= 8, "{checked_against_statsmodels}");
+    assert!(
+        checked_against_statsmodels >= 8,
+        "{checked_against_statsmodels}"
+    );
     print_worst();
 }
 
@@ -255,11 +376,27 @@ fn the_fixture_covers_every_branch() {
     for m in ["exact", "permutation", "asymptotic"] {
         assert!(methods.iter().filter(|&&x| x == m).count() >= 2, "{m}");
     }
-    let tables: Vec<Discordance> =
-        r["mcnemar"].as_array().unwrap().iter().map(|e| table(&e["table"])).collect();
+    let tables: Vec<Discordance> = r["mcnemar"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| table(&e["table"]))
+        .collect();
     assert!(tables.iter().any(|t| t.discordant() == 0));
-    assert!(r["paired_t"].as_array().unwrap().iter().any(|e| e["t"] == "inf"));
-    assert!(r["paired_t"].as_array().unwrap().iter().any(|e| e["t"].is_null()));
+    assert!(
+        r["paired_t"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|e| e["t"] == "inf")
+    );
+    assert!(
+        r["paired_t"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|e| e["t"].is_null())
+    );
     assert_eq!(r["versions"]["scipy"], "1.17.1");
     assert_eq!(r["versions"]["statsmodels"], "0.15.0");
 }

@@ -80,7 +80,10 @@ mod tests {
     fn confidence_must_be_inside_the_open_unit_interval() {
         for bad in [0.0, 1.0, -0.5, 1.5, f64::NAN, f64::INFINITY] {
             assert!(
-                matches!(two_sided_tail(bad), Err(InferenceError::InvalidConfidence(_))),
+                matches!(
+                    two_sided_tail(bad),
+                    Err(InferenceError::InvalidConfidence(_))
+                ),
                 "{bad}"
             );
         }

@@ -172,7 +172,10 @@ mod tests {
         ] {
             let r = newcombe_paired_difference(&t, 0.95).unwrap();
             assert!(r.ci[0] >= -1.0 && r.ci[1] <= 1.0, "{t:?}: {r:?}");
-            assert!(r.ci[0] <= r.difference && r.difference <= r.ci[1], "{t:?}: {r:?}");
+            assert!(
+                r.ci[0] <= r.difference && r.difference <= r.ci[1],
+                "{t:?}: {r:?}"
+            );
             assert!(r.ci[1] - r.ci[0] > 0.0, "{t:?}: {r:?}");
         }
     }

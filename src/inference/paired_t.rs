@@ -118,7 +118,10 @@ mod tests {
         let r = paired_t(&[-2.0; 3], 0.9).unwrap();
         assert_eq!((r.t, r.p_two_sided), (f64::NEG_INFINITY, 0.0));
         let r = paired_t(&[0.0; 5], 0.95).unwrap();
-        assert_eq!((r.mean, r.sd, r.ci, r.t, r.p_two_sided), (0.0, 0.0, [0.0, 0.0], 0.0, 1.0));
+        assert_eq!(
+            (r.mean, r.sd, r.ci, r.t, r.p_two_sided),
+            (0.0, 0.0, [0.0, 0.0], 0.0, 1.0)
+        );
     }
 
     #[test]

@@ -191,11 +191,19 @@ mod tests {
 
     #[test]
     fn method_follows_scipy_auto() {
-        let distinct: Vec<f64> = (1..=50).map(|i| i as f64 * if i % 3 == 0 { -1.0 } else { 1.0 }).collect();
-        assert_eq!(wilcoxon_signed_rank(&distinct).unwrap().method, WilcoxonMethod::Exact);
+        let distinct: Vec<f64> = (1..=50)
+            .map(|i| i as f64 * if i % 3 == 0 { -1.0 } else { 1.0 })
+            .collect();
+        assert_eq!(
+            wilcoxon_signed_rank(&distinct).unwrap().method,
+            WilcoxonMethod::Exact
+        );
         let mut more = distinct.clone();
         more.push(51.0);
-        assert_eq!(wilcoxon_signed_rank(&more).unwrap().method, WilcoxonMethod::Normal);
+        assert_eq!(
+            wilcoxon_signed_rank(&more).unwrap().method,
+            WilcoxonMethod::Normal
+        );
         // A zero makes the 13-value sample a permutation test, the 14-value one normal.
         let mut with_zero: Vec<f64> = (1..=12).map(f64::from).collect();
         with_zero.push(0.0);
@@ -204,7 +212,10 @@ mod tests {
             WilcoxonMethod::Permutation
         );
         with_zero.push(-13.0);
-        assert_eq!(wilcoxon_signed_rank(&with_zero).unwrap().method, WilcoxonMethod::Normal);
+        assert_eq!(
+            wilcoxon_signed_rank(&with_zero).unwrap().method,
+            WilcoxonMethod::Normal
+        );
         // A tie alone does the same.
         let tied = [1.0, -1.0, 2.0, 3.0];
         assert_eq!(
@@ -217,7 +228,11 @@ mod tests {
     fn all_zero_differences_give_p_one() {
         for n in [1, 13, 14, 60] {
             let r = wilcoxon_signed_rank(&vec![0.0; n]).unwrap();
-            assert_eq!((r.n_nonzero, r.statistic, r.p_two_sided), (0, 0.0, 1.0), "{n}");
+            assert_eq!(
+                (r.n_nonzero, r.statistic, r.p_two_sided),
+                (0, 0.0, 1.0),
+                "{n}"
+            );
         }
     }
 
