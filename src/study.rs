@@ -6,13 +6,13 @@
 //! - [`plan`]: the plan format ([`PLAN_FORMAT`]), checked before any run;
 //! - [`endpoints`]: the figures a plan may name and their units;
 //! - [`runner`]: the runs and their rows (JSONL), shards and resumption;
-//! - [`analysis`]: paired differences, t-interval, t-test, Wilcoxon, Holm, McNemar, Newcombe;
+//! - [`analysis`]: paired differences, t-interval, t-test, Wilcoxon, Holm, McNemar, Newcombe
+//!   (computed by [`crate::inference`]);
 //! - [`report`], [`figure`], [`provenance`]: the report folder and what it cites.
 
 pub mod analysis;
 pub mod endpoints;
 pub mod figure;
-mod inference_stub;
 pub mod plan;
 pub mod provenance;
 pub mod report;

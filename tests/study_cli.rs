@@ -76,6 +76,7 @@ fn the_small_plan_writes_a_report_with_every_section() {
         "## Beside them: the other window",
         "## Collisions",
         "McNemar",
+        "Newcombe",
         "## Figure",
         "effects.png",
         "obstacle.max_abs_yaw_rate_radps",

@@ -17,7 +17,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::inference_stub as inference;
+use crate::inference;
 use super::plan::{EndpointWindow, StudyPlan};
 use super::runner::StudyRow;
 use crate::sweep::RunStatus;
@@ -354,7 +354,7 @@ fn collision_comparison(
         difference: difference.as_ref().map(|d| d.difference),
         ci95: difference.as_ref().map(|d| d.ci),
         method: difference
-            .map(|d| d.method)
+            .map(|d| d.method.to_string())
             .unwrap_or_else(|| "no paired instance".into()),
     }
 }
