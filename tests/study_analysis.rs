@@ -105,10 +105,12 @@ fn paired_statistics_windows_holm_and_collisions() {
     let primary = find("obstacle.max_abs_yaw_rate_radps", "pre-contact");
     assert!(primary.tested && primary.role == "primary");
     assert_eq!((primary.n, primary.n_excluded), (6, 0));
-    let d: Vec<f64> = (0..6).map(|i| {
-        let x = i as f64;
-        (0.01 + 0.002 * x + 0.001 * (x + 1.0)) - (0.01 + 0.002 * x)
-    }).collect();
+    let d: Vec<f64> = (0..6)
+        .map(|i| {
+            let x = i as f64;
+            (0.01 + 0.002 * x + 0.001 * (x + 1.0)) - (0.01 + 0.002 * x)
+        })
+        .collect();
     let t = inference::paired_t(&d, 0.95).unwrap();
     assert_eq!(primary.mean_difference, Some(d.iter().sum::<f64>() / 6.0));
     assert_eq!(primary.ci95, Some(t.ci));
@@ -167,15 +169,33 @@ fn failed_runs_and_null_figures_leave_their_pairs_out() {
     let mut rows = Vec::new();
     for i in 0..6u64 {
         let x = i as f64;
-        rows.push(row(i, "pf-sp", false, [0.01, 0.001, 14.0], [0.01, 0.001, 14.0]));
-        rows.push(row(i, "pf-iso", false, [0.01 + 0.001 * x, 0.001, 14.0], [0.01, 0.001, 14.0]));
+        rows.push(row(
+            i,
+            "pf-sp",
+            false,
+            [0.01, 0.001, 14.0],
+            [0.01, 0.001, 14.0],
+        ));
+        rows.push(row(
+            i,
+            "pf-iso",
+            false,
+            [0.01 + 0.001 * x, 0.001, 14.0],
+            [0.01, 0.001, 14.0],
+        ));
     }
     // Instance 1 of pf-iso diverged; instance 3's reference sideslip is null (never measured).
-    let failed = rows.iter_mut().find(|r| r.instance == 1 && r.planner == "pf-iso").unwrap();
+    let failed = rows
+        .iter_mut()
+        .find(|r| r.instance == 1 && r.planner == "pf-iso")
+        .unwrap();
     failed.status = RunStatus::Diverged;
     failed.error = Some("diverged".into());
     failed.endpoints.clear();
-    let null = rows.iter_mut().find(|r| r.instance == 3 && r.planner == "pf-sp").unwrap();
+    let null = rows
+        .iter_mut()
+        .find(|r| r.instance == 3 && r.planner == "pf-sp")
+        .unwrap();
     null.endpoints
         .get_mut("obstacle.max_abs_sideslip_rad")
         .unwrap()
@@ -187,8 +207,20 @@ fn failed_runs_and_null_figures_leave_their_pairs_out() {
             .find(|e| e.endpoint == endpoint && e.tested)
             .unwrap()
     };
-    assert_eq!((get("obstacle.max_abs_yaw_rate_radps").n, get("obstacle.max_abs_yaw_rate_radps").n_excluded), (5, 1));
-    assert_eq!((get("obstacle.max_abs_sideslip_rad").n, get("obstacle.max_abs_sideslip_rad").n_excluded), (4, 2));
+    assert_eq!(
+        (
+            get("obstacle.max_abs_yaw_rate_radps").n,
+            get("obstacle.max_abs_yaw_rate_radps").n_excluded
+        ),
+        (5, 1)
+    );
+    assert_eq!(
+        (
+            get("obstacle.max_abs_sideslip_rad").n,
+            get("obstacle.max_abs_sideslip_rad").n_excluded
+        ),
+        (4, 2)
+    );
     assert_eq!(a.collisions[0].n, 5);
     assert_eq!(a.failed_runs.len(), 1);
 }

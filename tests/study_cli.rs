@@ -259,14 +259,34 @@ fn shards_merged_threads_and_resumption_give_the_whole_studys_report() {
     let dir = scratch("study_shards");
     let plan = write_plan(&dir, "p.toml", &small_plan(3));
     let whole1 = dir.join("whole1");
-    let out = merge_sim(&["study", s(&plan), "--out", s(&whole1), "--threads", "1", "-q"]);
+    let out = merge_sim(&[
+        "study",
+        s(&plan),
+        "--out",
+        s(&whole1),
+        "--threads",
+        "1",
+        "-q",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let reference = tables(&whole1);
 
     let whole2 = dir.join("whole2");
-    let out = merge_sim(&["study", s(&plan), "--out", s(&whole2), "--threads", "2", "-q"]);
+    let out = merge_sim(&[
+        "study",
+        s(&plan),
+        "--out",
+        s(&whole2),
+        "--threads",
+        "2",
+        "-q",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert_eq!(tables(&whole2), reference, "thread count changed the report");
+    assert_eq!(
+        tables(&whole2),
+        reference,
+        "thread count changed the report"
+    );
 
     let sharded = dir.join("sharded");
     for shard in ["0/2", "1/2"] {
@@ -280,11 +300,22 @@ fn shards_merged_threads_and_resumption_give_the_whole_studys_report() {
             "-q",
         ]);
         assert!(out.status.success(), "{}", stderr(&out));
-        assert!(!sharded.join("report.md").exists(), "a shard writes no report");
+        assert!(
+            !sharded.join("report.md").exists(),
+            "a shard writes no report"
+        );
     }
     // Merging before every shard is there is refused.
     let lonely = dir.join("lonely");
-    let out = merge_sim(&["study", s(&plan), "--out", s(&lonely), "--shard", "0/2", "-q"]);
+    let out = merge_sim(&[
+        "study",
+        s(&plan),
+        "--out",
+        s(&lonely),
+        "--shard",
+        "0/2",
+        "-q",
+    ]);
     assert!(out.status.success());
     let out = merge_sim(&["study", s(&plan), "--out", s(&lonely), "--merge"]);
     assert_eq!(out.status.code(), Some(2));
@@ -298,12 +329,20 @@ fn shards_merged_threads_and_resumption_give_the_whole_studys_report() {
     std::fs::create_dir(&resumed).unwrap();
     std::fs::write(resumed.join(".mergesim-study"), "").unwrap();
     let rows = read(&whole1.join("rows.jsonl"));
-    let cut: String = rows.lines().take(5).map(|l| format!("{l}\n")).collect::<String>()
+    let cut: String = rows
+        .lines()
+        .take(5)
+        .map(|l| format!("{l}\n"))
+        .collect::<String>()
         + &rows.lines().nth(5).unwrap()[..20];
     std::fs::write(resumed.join("rows.jsonl"), cut).unwrap();
     let out = merge_sim(&["study", s(&plan), "--out", s(&resumed), "--resume"]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert!(stderr(&out).contains("resuming: 5 finished, 7 to run"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("resuming: 5 finished, 7 to run"),
+        "{}",
+        stderr(&out)
+    );
     assert_eq!(tables(&resumed), reference, "resumed study differs");
 }
 
@@ -335,8 +374,8 @@ fn study_help_explains_the_plan_format() {
 #[test]
 fn the_example_plan_runs_and_reports() {
     let dir = scratch("study_example");
-    let example = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("docs/studies/examples/urgent_merge_small.toml");
+    let example =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/studies/examples/urgent_merge_small.toml");
     let plan = dir.join("urgent_merge_small.toml");
     std::fs::copy(&example, &plan).unwrap();
     let started = std::time::Instant::now();
@@ -357,6 +396,9 @@ fn the_example_plan_runs_and_reports() {
     assert_eq!(read(&report.join("rows.jsonl")).lines().count(), 40);
     // Progress and the primary results on the terminal.
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("obstacle.max_abs_yaw_rate_radps"), "{stdout}");
+    assert!(
+        stdout.contains("obstacle.max_abs_yaw_rate_radps"),
+        "{stdout}"
+    );
     eprintln!("example study: {:.1} s", started.elapsed().as_secs_f64());
 }

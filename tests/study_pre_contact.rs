@@ -22,7 +22,10 @@ fn pre_contact_figures_are_the_run_truncated_at_its_first_contact() {
     // The rear car keeps pushing after the impact: the whole-run figures move after it.
     let mut moved = false;
     for v in &outcome.vehicles {
-        let before = v.pre_contact.as_deref().expect("a run with a contact freezes figures");
+        let before = v
+            .pre_contact
+            .as_deref()
+            .expect("a run with a contact freezes figures");
         assert!(before.pre_contact.is_none());
         assert!(before.max_abs_yaw_rate_radps <= v.max_abs_yaw_rate_radps);
         assert!(before.max_abs_sideslip_rad <= v.max_abs_sideslip_rad);
@@ -34,7 +37,10 @@ fn pre_contact_figures_are_the_run_truncated_at_its_first_contact() {
         // Through the summary's accessor too.
         assert_eq!(v.before_first_contact(), before);
     }
-    assert!(moved, "the impact should raise some vehicle's peak acceleration");
+    assert!(
+        moved,
+        "the impact should raise some vehicle's peak acceleration"
+    );
 
     // The same run stopped at the last logged instant strictly before the contact.
     let log_period_s = scenario.sim.log_period_s;

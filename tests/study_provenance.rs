@@ -90,12 +90,17 @@ fn committed_plans_are_confirmatory_and_changed_ones_exploratory() {
     assert!(md.contains("> **exploratory**"), "{md}");
 
     // Modified and committed again: still not the version first added, still exploratory.
-    git(&repo, &["commit", "-q", "-am", "change the seed after the fact"]);
+    git(
+        &repo,
+        &["commit", "-q", "-am", "change the seed after the fact"],
+    );
     let p = of_plan(&plan, &changed);
     assert!(p.exploratory);
     assert_eq!(p.plan_added_in.as_deref(), Some(added.as_str()));
     assert!(
-        p.reasons.iter().any(|r| r.contains("differs from the version")),
+        p.reasons
+            .iter()
+            .any(|r| r.contains("differs from the version")),
         "{:?}",
         p.reasons
     );

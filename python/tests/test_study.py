@@ -77,5 +77,5 @@ def test_the_tables_equal_the_cli_report(merge_sim: str, plan: pathlib.Path, tab
 def test_a_bad_plan_raises_scenario_error(tmp_path: pathlib.Path) -> None:
     bad = tmp_path / "bad.toml"
     bad.write_text(PLAN.replace('"0.5 m/s"', "0.5"))
-    with pytest.raises(mergesim.ScenarioError, match=r"bad.toml, line 15: .*without a unit"):
+    with pytest.raises(mergesim.ScenarioError, match=r"bad.toml, line 16: .*without a unit"):
         mergesim.study(bad)

@@ -17,9 +17,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::inference;
 use super::plan::{EndpointWindow, StudyPlan};
 use super::runner::StudyRow;
+use crate::inference;
 use crate::sweep::RunStatus;
 use crate::sweep::statistics::nearest_rank_percentile;
 
@@ -268,9 +268,7 @@ pub fn analyse(plan: &StudyPlan, rows: &[StudyRow]) -> Analysis {
 fn compare(values: &[(f64, f64)], threshold: f64) -> EndpointComparison {
     let n = values.len();
     let differences: Vec<f64> = values.iter().map(|(p, r)| p - r).collect();
-    let mean = |xs: &mut dyn Iterator<Item = f64>| {
-        (n > 0).then(|| xs.sum::<f64>() / n as f64)
-    };
+    let mean = |xs: &mut dyn Iterator<Item = f64>| (n > 0).then(|| xs.sum::<f64>() / n as f64);
     let mut sorted = differences.clone();
     sorted.sort_by(f64::total_cmp);
     let mut notes = Vec::new();

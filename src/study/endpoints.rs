@@ -194,7 +194,12 @@ mod tests {
         assert_eq!(e.vehicle.as_deref(), Some("obstacle"));
         assert!(EndpointFigure::parse("obstacle.merge_zone_rms_yaw_rate_radps", &vehicles).is_ok());
         assert!(EndpointFigure::parse("min_ttc_s", &vehicles).is_ok());
-        for bad in ["truck.max_abs_yaw_rate_radps", "ego.max_yaw", "peak", "ego.pre_contact"] {
+        for bad in [
+            "truck.max_abs_yaw_rate_radps",
+            "ego.max_yaw",
+            "peak",
+            "ego.pre_contact",
+        ] {
             let err = EndpointFigure::parse(bad, &vehicles).unwrap_err();
             assert!(err.contains("unknown endpoint"), "{bad}: {err}");
         }

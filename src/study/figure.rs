@@ -66,8 +66,12 @@ pub fn write_effects_png(path: &Path, report: &StudyReport) -> Result<(), PlotEr
                 RGBColor(120, 120, 120),
             ))
             .map_err(|e| e.to_string())?;
-            area.draw(&Text::new(format!("{v}"), (x_of(v) - 8, y_end + 6), font(13)))
-                .map_err(|e| e.to_string())?;
+            area.draw(&Text::new(
+                format!("{v}"),
+                (x_of(v) - 8, y_end + 6),
+                font(13),
+            ))
+            .map_err(|e| e.to_string())?;
         }
         area.draw(&Text::new(
             format!("axis: (planner − reference) / δ, from −{extent:.3} to {extent:.3}"),
@@ -83,7 +87,11 @@ pub fn write_effects_png(path: &Path, report: &StudyReport) -> Result<(), PlotEr
                 r.planner,
                 r.reference,
                 r.endpoint,
-                if r.role == "primary" { " (primary)" } else { "" }
+                if r.role == "primary" {
+                    " (primary)"
+                } else {
+                    ""
+                }
             );
             area.draw(&Text::new(label, (10, y - 8), font(13)))
                 .map_err(|e| e.to_string())?;

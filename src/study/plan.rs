@@ -206,10 +206,7 @@ impl StudyPlan {
 
     /// FNV-1a 64 of the plan text (hex): the identity its rows carry.
     pub fn fingerprint(&self) -> String {
-        format!(
-            "{:016x}",
-            scenarios::randomisation::fnv1a64(&self.text)
-        )
+        format!("{:016x}", scenarios::randomisation::fnv1a64(&self.text))
     }
 
     /// Loads and checks the plan at `path`.
@@ -233,18 +230,12 @@ impl StudyPlan {
         })?;
         let invalid = |at: &[&str], field: &str, message: String| PlanError::Invalid {
             origin: origin.clone(),
-            line: line_of(
-                text,
-                &at.iter().map(|s| s.to_string()).collect::<Vec<_>>(),
-            ),
+            line: line_of(text, &at.iter().map(|s| s.to_string()).collect::<Vec<_>>()),
             field: field.to_string(),
             message,
         };
         // The scenario: a built-in name, else a path relative to the plan.
-        let scenario_path = path
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join(&raw.scenario);
+        let scenario_path = path.parent().unwrap_or(Path::new(".")).join(&raw.scenario);
         let scenario = if scenarios::builtin::toml_of(&raw.scenario).is_some() {
             Scenario::load(&raw.scenario)
         } else {
@@ -266,9 +257,10 @@ impl StudyPlan {
             }
             planners.push(kind);
         }
-        let reference: PlannerKind = raw.reference.parse().map_err(|e: planner::PlannerError| {
-            invalid(&["reference"], "reference", e.to_string())
-        })?;
+        let reference: PlannerKind =
+            raw.reference.parse().map_err(|e: planner::PlannerError| {
+                invalid(&["reference"], "reference", e.to_string())
+            })?;
         if !planners.contains(&reference) {
             return Err(invalid(
                 &["reference"],
@@ -458,4 +450,3 @@ impl StudyPlan {
         })
     }
 }
-

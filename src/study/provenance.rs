@@ -52,12 +52,9 @@ pub fn of_plan(path: &Path, text: &str) -> Provenance {
     let plan_blob = git(dir, &["hash-object", "--", &file]);
     let in_repo = git(dir, &["rev-parse", "--is-inside-work-tree"]).as_deref() == Some("true");
     let plan_added_in = if in_repo {
-        git(
-            dir,
-            &["log", "--diff-filter=A", "--format=%H", "--", &file],
-        )
-        .and_then(|out| out.lines().last().map(str::to_string))
-        .filter(|s| !s.is_empty())
+        git(dir, &["log", "--diff-filter=A", "--format=%H", "--", &file])
+            .and_then(|out| out.lines().last().map(str::to_string))
+            .filter(|s| !s.is_empty())
     } else {
         None
     };

@@ -182,8 +182,14 @@ pub fn write_report(out: &Path, report: &StudyReport) -> Result<(), OutputError>
             source: std::io::Error::other(e.to_string()),
         }
     })?;
-    write(ENDPOINTS_CSV, endpoints_csv(&report.analysis.endpoints).as_bytes())?;
-    write(COLLISIONS_CSV, collisions_csv(&report.analysis.collisions).as_bytes())?;
+    write(
+        ENDPOINTS_CSV,
+        endpoints_csv(&report.analysis.endpoints).as_bytes(),
+    )?;
+    write(
+        COLLISIONS_CSV,
+        collisions_csv(&report.analysis.collisions).as_bytes(),
+    )?;
     write(REPORT_JSON, json.as_bytes())?;
     write(REPORT_MD, markdown(report).as_bytes())
 }
@@ -370,7 +376,9 @@ pub fn markdown(report: &StudyReport) -> String {
     let _ = writeln!(
         out,
         "- commit that first added the plan: `{}`",
-        prov.plan_added_in.as_deref().unwrap_or("none (never committed)")
+        prov.plan_added_in
+            .as_deref()
+            .unwrap_or("none (never committed)")
     );
     let _ = writeln!(out, "- simulator commit: `{}`", prov.simulator_commit);
     let _ = writeln!(

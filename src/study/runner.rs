@@ -186,10 +186,8 @@ pub fn run_study(
 ) -> Result<Vec<StudyRow>, StudyError> {
     let shard = options.shard.unwrap_or(Shard::WHOLE);
     let keys = run_keys(plan, shard);
-    let wanted: BTreeSet<(usize, u64, &str)> = keys
-        .iter()
-        .map(|(c, i, p)| (*c, *i, p.as_str()))
-        .collect();
+    let wanted: BTreeSet<(usize, u64, &str)> =
+        keys.iter().map(|(c, i, p)| (*c, *i, p.as_str())).collect();
     let mut done = BTreeSet::new();
     for row in &options.resume {
         let key = (row.cell, row.instance, row.planner.as_str());

@@ -187,7 +187,12 @@ pub(crate) fn cmd_study(args: &StudyArgs, interrupt: &Interrupt) -> Result<(), F
 }
 
 /// Analyses complete rows, writes the report and prints where it is.
-fn finish(args: &StudyArgs, plan: &StudyPlan, out: &Path, rows: &[StudyRow]) -> Result<(), Failure> {
+fn finish(
+    args: &StudyArgs,
+    plan: &StudyPlan,
+    out: &Path,
+    rows: &[StudyRow],
+) -> Result<(), Failure> {
     runner::check_complete(plan, rows).map_err(study_failure)?;
     let report = StudyReport::new(
         plan,

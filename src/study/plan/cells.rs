@@ -30,14 +30,16 @@ pub(super) fn factor_levels(
         (Some(_), Some(_)) => Err(invalid(
             &["cells"],
             "cells",
-            "give either [factors] (a full factorial) or [[cells]] (listed cells), not both"
-                .into(),
+            "give either [factors] (a full factorial) or [[cells]] (listed cells), not both".into(),
         )),
         (None, None) => Ok(vec![Vec::new()]),
         (Some(table), None) => {
             let mut factors = Vec::new();
-            flatten(table, &mut vec!["factors".into()], "", &mut |name, at, value| {
-                match value {
+            flatten(
+                table,
+                &mut vec!["factors".into()],
+                "",
+                &mut |name, at, value| match value {
                     toml::Value::Array(levels) => {
                         factors.push(Factor {
                             name,
@@ -51,8 +53,8 @@ pub(super) fn factor_levels(
                         name.clone(),
                         format!("{other}: a factor's levels are a list, e.g. [0.8, 0.5]"),
                     )),
-                }
-            })
+                },
+            )
             .map_err(|(at, name, m)| {
                 invalid(
                     &at.iter().map(String::as_str).collect::<Vec<_>>(),
@@ -214,13 +216,16 @@ pub(super) fn resolve_cells(
                 origin: origin.into(),
                 message: e.to_string(),
             })?;
-            Scenario::from_toml(&alone_text, &format!("{} with {name} = {value}", scenario.name))
-                .map_err(|e| PlanError::Invalid {
-                    origin: origin.into(),
-                    line: line_of(text, at),
-                    field: format!("{}.{name}", at[0]),
-                    message: format!("{name} = {value}: {e}"),
-                })?;
+            Scenario::from_toml(
+                &alone_text,
+                &format!("{} with {name} = {value}", scenario.name),
+            )
+            .map_err(|e| PlanError::Invalid {
+                origin: origin.into(),
+                line: line_of(text, at),
+                field: format!("{}.{name}", at[0]),
+                message: format!("{name} = {value}: {e}"),
+            })?;
         }
         let cell_text = toml::to_string(&table).map_err(|e| PlanError::Parse {
             origin: origin.into(),
@@ -229,15 +234,17 @@ pub(super) fn resolve_cells(
         let cell_scenario =
             Scenario::from_toml(&cell_text, &format!("{} in cell {label}", scenario.name))
                 .map_err(|e| {
-                    let at = values.first().map(|(_, at, _)| at.clone()).unwrap_or_default();
+                    let at = values
+                        .first()
+                        .map(|(_, at, _)| at.clone())
+                        .unwrap_or_default();
                     PlanError::Invalid {
                         origin: origin.into(),
                         line: line_of(text, &at),
-                        field: values
-                            .first()
-                            .map_or_else(|| "scenario".into(), |(name, at, _)| {
-                                format!("{}.{name}", at[0])
-                            }),
+                        field: values.first().map_or_else(
+                            || "scenario".into(),
+                            |(name, at, _)| format!("{}.{name}", at[0]),
+                        ),
                         message: format!("cell {index} ({label}): {e}"),
                     }
                 })?;
@@ -267,7 +274,9 @@ fn has_path(table: &toml::Table, path: &[String]) -> bool {
         let next = match (i, current) {
             (0, _) => table.get(segment),
             (_, Some(toml::Value::Table(t))) => t.get(segment),
-            (_, Some(toml::Value::Array(a))) => segment.parse::<usize>().ok().and_then(|k| a.get(k)),
+            (_, Some(toml::Value::Array(a))) => {
+                segment.parse::<usize>().ok().and_then(|k| a.get(k))
+            }
             _ => None,
         };
         match next {
