@@ -36,13 +36,25 @@ fn factors_are_a_full_factorial_of_any_scenario_value() {
     // Each cell's scenario holds its values (nested keys `sim.mu = …` work as quoted ones).
     for (cell, scenario) in &plan.cells {
         let label = cell.label();
-        let mu = if label.contains("sim.mu=0.6") { 0.6 } else { 0.8 };
+        let mu = if label.contains("sim.mu=0.6") {
+            0.6
+        } else {
+            0.8
+        };
         assert_eq!(scenario.sim.mu, mu, "{label}");
         let ego = scenario.vehicles.iter().find(|v| v.name == "ego").unwrap();
-        let speed = if label.contains("target_speed_mps=16.0") { 16.0 } else { 14.0 };
+        let speed = if label.contains("target_speed_mps=16.0") {
+            16.0
+        } else {
+            14.0
+        };
         assert_eq!(ego.target_speed_mps, speed, "{label}");
         assert_eq!(scenario.sim.planner.interaction_time_gap_s, 1.0);
-        let set = if label.contains("params=\"paper\"") { "paper" } else { "mergesim" };
+        let set = if label.contains("params=\"paper\"") {
+            "paper"
+        } else {
+            "mergesim"
+        };
         assert_eq!(scenario.params.name(), set, "{label}");
     }
 }
@@ -62,23 +74,41 @@ fn listed_cells_and_no_factors() {
 fn refusals_name_the_line() {
     // HEAD has 9 lines.
     let cases = [
-        ("[factors]\n\"sim.mu\" = [0.8]\n[[cells]]\n\"sim.mu\" = 0.7\n", "not both", 12),
-        ("[[cells]]\n\"sim.mu\" = 0.7\n[[cells]]\n\"sim.mu\" = 0.7\n", "repeats cell 0", 13),
+        (
+            "[factors]\n\"sim.mu\" = [0.8]\n[[cells]]\n\"sim.mu\" = 0.7\n",
+            "not both",
+            12,
+        ),
+        (
+            "[[cells]]\n\"sim.mu\" = 0.7\n[[cells]]\n\"sim.mu\" = 0.7\n",
+            "repeats cell 0",
+            13,
+        ),
         ("[factors]\n\"sim.mu\" = 0.8\n", "levels are a list", 11),
-        ("[factors]\n\"vehicles.truck.x_m\" = [1.0]\n", "unknown factor", 11),
+        (
+            "[factors]\n\"vehicles.truck.x_m\" = [1.0]\n",
+            "unknown factor",
+            11,
+        ),
         ("[factors]\n\"sim\" = [1.0]\n", "unknown factor", 11),
         ("[collisions]\nendpoints = \"after\"\n", "pre-contact", 11),
     ];
     for (extra, message, line) in cases {
         let err = load(extra).unwrap_err();
         assert!(err.contains(message), "{extra}: {err}");
-        assert!(err.contains(&format!("p.toml, line {line}:")), "{extra}: {err}");
+        assert!(
+            err.contains(&format!("p.toml, line {line}:")),
+            "{extra}: {err}"
+        );
     }
     let text = HEAD.replace("reference = \"pf-sp\"", "reference = \"pf-cs\"");
     let err = StudyPlan::from_text(&text, Path::new("p.toml"))
         .unwrap_err()
         .to_string();
-    assert!(err.contains("line 4") && err.contains("not one of the planners"), "{err}");
+    assert!(
+        err.contains("line 4") && err.contains("not one of the planners"),
+        "{err}"
+    );
     let text = HEAD.replace("n = 4", "n = 1");
     let err = StudyPlan::from_text(&text, Path::new("p.toml"))
         .unwrap_err()
@@ -88,5 +118,8 @@ fn refusals_name_the_line() {
     let err = StudyPlan::from_text(&text, Path::new("p.toml"))
         .unwrap_err()
         .to_string();
-    assert!(err.contains("unknown_key") && err.contains("line 10"), "{err}");
+    assert!(
+        err.contains("unknown_key") && err.contains("line 10"),
+        "{err}"
+    );
 }

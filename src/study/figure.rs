@@ -19,7 +19,28 @@ pub fn write_effects_png(path: &Path, report: &StudyReport) -> Result<(), PlotEr
         .filter(|r| r.tested)
         .collect();
     let row_h = 26i32;
-    let (left, right, top) = (560i32, 40i32, 70i32);
+    let label = |r: &super::analysis::EndpointComparison| {
+        format!(
+            "{} | {} − {} | {}{}",
+            r.cell_label,
+            r.planner,
+            r.reference,
+            r.endpoint,
+            if r.role == "primary" {
+                " (primary)"
+            } else {
+                ""
+            }
+        )
+    };
+    // About 7 px per character of the 13 px font, and a margin.
+    let longest = rows
+        .iter()
+        .map(|r| label(r).chars().count())
+        .max()
+        .unwrap_or(0);
+    let left = (30 + 7 * longest as i32).max(300);
+    let (right, top) = (40i32, 70i32);
     let plot_w = 560i32;
     let width = (left + plot_w + right) as u32;
     let height = (top + row_h * rows.len().max(1) as i32 + 50) as u32;
@@ -60,15 +81,15 @@ pub fn write_effects_png(path: &Path, report: &StudyReport) -> Result<(), PlotEr
             RGBColor(225, 240, 225).filled(),
         ))
         .map_err(|e| e.to_string())?;
-        for v in [-1.0, 0.0, 1.0] {
+        for v in [-extent, -1.0, 0.0, 1.0, extent] {
             area.draw(&PathElement::new(
                 vec![(x_of(v), top - 6), (x_of(v), y_end)],
                 RGBColor(120, 120, 120),
             ))
             .map_err(|e| e.to_string())?;
             area.draw(&Text::new(
-                format!("{v}"),
-                (x_of(v) - 8, y_end + 6),
+                format!("{v:.3}"),
+                (x_of(v) - 14, y_end + 6),
                 font(13),
             ))
             .map_err(|e| e.to_string())?;
@@ -81,19 +102,7 @@ pub fn write_effects_png(path: &Path, report: &StudyReport) -> Result<(), PlotEr
         .map_err(|e| e.to_string())?;
         for (k, (r, s)) in rows.iter().zip(&scaled).enumerate() {
             let y = top + k as i32 * row_h + row_h / 2;
-            let label = format!(
-                "{} | {} − {} | {}{}",
-                r.cell_label,
-                r.planner,
-                r.reference,
-                r.endpoint,
-                if r.role == "primary" {
-                    " (primary)"
-                } else {
-                    ""
-                }
-            );
-            area.draw(&Text::new(label, (10, y - 8), font(13)))
+            area.draw(&Text::new(label(r), (10, y - 8), font(13)))
                 .map_err(|e| e.to_string())?;
             let Some((lo, mean, hi)) = s else {
                 area.draw(&Text::new("not estimable", (left + 4, y - 8), font(13)))
