@@ -11,7 +11,12 @@ use crate::summary::RunSummary;
 pub const RUN_FIGURES: [&str; 3] = ["min_gap_m", "min_ttc_s", "tet_s"];
 
 /// Per-vehicle figures that are not endpoints (bookkeeping, not outcomes).
-const NOT_ENDPOINTS: [&str; 3] = ["samples", "duration_s", "divider_crossings"];
+const NOT_ENDPOINTS: [&str; 3] = [
+    "samples",
+    "duration_s",
+    // A table ({t_s, x_m}) or null, not a number.
+    "divider_crossing",
+];
 
 /// The per-vehicle figures an endpoint may name, sorted: every numeric field of a vehicle's
 /// summary and of its `paper_metrics` (read off a summary, so new figures join by themselves).

@@ -166,6 +166,27 @@ pub fn create_out(out: &Path) -> Result<(), OutputError> {
     Ok(())
 }
 
+/// Removes the report files of an earlier run from `out` (before a new run, so an interrupted
+/// one never leaves an old report beside new rows).
+pub fn remove_stale(out: &Path) -> Result<(), OutputError> {
+    for name in [
+        REPORT_MD,
+        REPORT_JSON,
+        ENDPOINTS_CSV,
+        COLLISIONS_CSV,
+        EFFECTS_PNG,
+    ] {
+        let path = out.join(name);
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(OutputError::Io { path, source: e });
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// Writes every report file into `out` (created with [`create_out`]).
 pub fn write_report(out: &Path, report: &StudyReport) -> Result<(), OutputError> {
     let write = |name: &str, bytes: &[u8]| {

@@ -111,6 +111,9 @@ pub(crate) fn cmd_study(args: &StudyArgs, interrupt: &Interrupt) -> Result<(), F
     };
     // Every check done: the folder and the rows file.
     create_out(&out).map_err(input)?;
+    if shard == Shard::WHOLE {
+        report::remove_stale(&out).map_err(run_failure)?;
+    }
     let file = open_rows(&rows_path, keep_len)?;
     let range = shard.instances(plan.instances);
     eprintln!(
