@@ -123,12 +123,15 @@ pub(super) fn factor_levels(
 
 type FlattenError = (Vec<String>, String, String);
 
+/// What [`flatten`] calls for each leaf: (dotted name, TOML path in the plan, value).
+type Visitor<'a> = dyn FnMut(String, Vec<String>, &toml::Value) -> Result<(), FlattenError> + 'a;
+
 /// Visits the leaves of `table` as dotted names (`sim.mu` written quoted or as nested keys).
 fn flatten(
     table: &toml::Table,
     at: &mut Vec<String>,
     prefix: &str,
-    visit: &mut dyn FnMut(String, Vec<String>, &toml::Value) -> Result<(), FlattenError>,
+    visit: &mut Visitor<'_>,
 ) -> Result<(), FlattenError> {
     for (key, value) in table {
         let name = if prefix.is_empty() {
