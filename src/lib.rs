@@ -19,6 +19,7 @@ pub mod plots;
 pub mod report;
 pub mod run_caption;
 pub mod scaling;
+pub mod study;
 pub mod summary;
 pub mod sweep;
 

@@ -116,6 +116,14 @@ pub fn other_limits() -> Vec<(String, String)> {
             format!("0 to {}", crate::grid::MAX_GRID_RUNS),
         ),
         (
+            "`study`: cells × planners × `instances.n`".into(),
+            format!(
+                "{} to {} runs",
+                2 * crate::study::plan::MIN_INSTANCES,
+                crate::study::MAX_STUDY_RUNS
+            ),
+        ),
+        (
             "`--threads`".into(),
             format!("1 to {}", crate::sweep::MAX_THREADS),
         ),

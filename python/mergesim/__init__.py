@@ -4,6 +4,8 @@
   (a pandas DataFrame with the ``--csv`` columns);
 - :func:`sweep` — seeded Monte-Carlo sweeps of several planners over the same instances (paired
   by seed), run in parallel in Rust, as a pandas DataFrame;
+- :func:`study` — a study plan (``merge_sim study PLAN.toml``) run in Rust, its report's tables
+  as pandas DataFrames;
 - :class:`MergeEnv` — a Gymnasium environment: the agent drives one vehicle through the
   simulator's tracker, the others run the scenario's planners (also registered as
   ``mergesim/Merge-v0``);
@@ -16,6 +18,7 @@ See python/README.md.
 from ._native import ScenarioError, SimulationError, builtin_scenarios, planners
 from .env import MergeEnv, RewardWeights
 from .run import RunResult, run
+from .study import study
 from .sweep import never_as_infinity, never_column, paired_differences, rows_frame, sweep
 
 try:
@@ -39,6 +42,7 @@ __all__ = [
     "planners",
     "rows_frame",
     "run",
+    "study",
     "sweep",
 ]
 

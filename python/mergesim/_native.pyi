@@ -32,6 +32,13 @@ def instance_seed(sweep_seed: int, instance: int) -> int:
 def parse_seed(text: str) -> int:
     """A seed written as text (``"0x..."`` or decimal digits); raises ScenarioError otherwise."""
 
+def study(
+    plan: str,
+    out: Optional[str] = None,
+    threads: Optional[int] = None,
+) -> str:
+    """The report (``report.json``) of the study plan at ``plan``, as JSON text."""
+
 def builtin_scenarios() -> List[str]:
     """Names of the built-in scenarios."""
 

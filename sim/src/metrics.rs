@@ -192,6 +192,21 @@ pub struct VehicleMetricsSummary {
     /// crossing); null when the metrics were made without a road.
     #[serde(default)]
     pub paper_metrics: Option<PaperMetricsSummary>,
+    /// The same figures as they stood at the run's first contact (vehicle–vehicle or road
+    /// edge, any vehicle): over the samples logged before it, so a peak reached while or after
+    /// the bodies touch does not enter. Absent (`None`) when the run had no contact: the
+    /// whole-run figures are then the pre-contact ones. Set by the run's log
+    /// ([`crate::run_log::RunLog`]) with [`VehicleMetrics::summary`] at the first contact.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pre_contact: Option<Box<VehicleMetricsSummary>>,
+}
+
+impl VehicleMetricsSummary {
+    /// The figures over the window before the run's first contact: [`Self::pre_contact`] if
+    /// the run had a contact, else the whole-run figures themselves.
+    pub fn before_first_contact(&self) -> &VehicleMetricsSummary {
+        self.pre_contact.as_deref().unwrap_or(self)
+    }
 }
 
 /// Hysteresis counter of sign changes of a signal beyond a threshold.
@@ -481,6 +496,7 @@ impl VehicleMetrics {
             rms_jerk_lat_mps3,
             collided: self.collided,
             paper_metrics: self.paper.as_ref().map(PaperMetrics::summary),
+            pre_contact: None,
         }
     }
 }

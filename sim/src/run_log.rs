@@ -14,6 +14,8 @@ pub struct RunLog {
     metrics: Vec<VehicleMetrics>,
     keep_time_series: bool,
     time_series: Vec<TimeSeriesRow>,
+    /// Every vehicle's figures frozen at the run's first contact (`None` before any).
+    pre_contact: Option<Vec<VehicleMetricsSummary>>,
 }
 
 impl RunLog {
@@ -23,12 +25,21 @@ impl RunLog {
             metrics,
             keep_time_series,
             time_series: Vec::new(),
+            pre_contact: None,
         }
     }
 
-    /// The summaries, in vehicle order.
+    /// The summaries, in vehicle order; after a contact each carries its figures as they
+    /// stood at the first one (`VehicleMetricsSummary::pre_contact`).
     pub fn summaries(&self) -> Vec<VehicleMetricsSummary> {
-        self.metrics.iter().map(VehicleMetrics::summary).collect()
+        let mut summaries: Vec<VehicleMetricsSummary> =
+            self.metrics.iter().map(VehicleMetrics::summary).collect();
+        if let Some(frozen) = &self.pre_contact {
+            for (summary, before) in summaries.iter_mut().zip(frozen) {
+                summary.pre_contact = Some(Box::new(before.clone()));
+            }
+        }
+        summaries
     }
 
     /// The time series (empty unless kept).
@@ -56,6 +67,12 @@ impl TickObserver for RunLog {
     }
 
     fn on_collision(&mut self, ids: &[VehicleId]) {
+        // The first contact of the run (vehicle–vehicle or road edge) freezes every vehicle's
+        // figures: the samples logged so far all precede it (the world checks safety before it
+        // logs the instant).
+        if self.pre_contact.is_none() {
+            self.pre_contact = Some(self.metrics.iter().map(VehicleMetrics::summary).collect());
+        }
         for id in ids {
             if let Some(m) = self.metrics.get_mut(*id as usize) {
                 m.set_collided();

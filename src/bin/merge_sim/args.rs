@@ -42,6 +42,11 @@ pub(crate) enum Command {
     /// Eq. 7 on/off} × {sub-steps on/off} × path time gap τ × interaction time gap τ_I, with
     /// paired differences against the first planner.
     Grid(GridArgs),
+    /// Run a study plan (TOML): factors × planners on the same instances, paired statistics
+    /// against the reference planner (t-interval, t-test, Wilcoxon, Holm; collisions: McNemar,
+    /// Newcombe), a report with tables, a figure and the plan's provenance. `merge_sim study
+    /// --help` explains the plan format.
+    Study(crate::study_command::StudyArgs),
     /// Print the allowed range of every scenario value and the limits on runs, threads and
     /// work, as a Markdown table (the README's "Limits" section is this output).
     Limits,

@@ -12,6 +12,7 @@
 mod args;
 mod commands;
 mod signals;
+mod study_command;
 mod sweep_commands;
 
 use std::process::ExitCode;
@@ -62,6 +63,7 @@ fn main() -> ExitCode {
         Some(Command::Sweep(args)) => sweep_commands::cmd_sweep(&args, &interrupt),
         Some(Command::MergeResults(args)) => sweep_commands::cmd_merge_results(&args),
         Some(Command::Grid(args)) => commands::cmd_grid(&args, &interrupt),
+        Some(Command::Study(args)) => study_command::cmd_study(&args, &interrupt),
         Some(Command::Limits) => commands::cmd_limits(),
     };
     match result {
