@@ -303,24 +303,15 @@ fn paper_set_pf_cs_obstacle_winds_in_the_merge_zone() {
     assert_eq!(collisions(&cs), 0);
 }
 
-/// The `paper` set: PF-ISO starts slowing before PF-SP's obstacle does, if that one slows at
-/// all. In this reading the vehicle PF-ISO slows is the ego, not the obstacle: with the printed
-/// D_min the planning vehicle is always the follower, so the interaction term only slows the
-/// faster vehicle (docs/reproduction.md).
-///
-/// Until the tracker's speed feed-forward was fixed (2026-12-02) this test also asserted that
-/// PF-SP's obstacle brakes (onset 13.85 s, to 14.89 m/s): that dip was the feed-forward's
-/// overshoot of a one-segment planned dip, not the planner's braking. With the fix the
-/// obstacle no longer slows by the onset's 0.1 m/s (lowest speed 14.97 m/s), so "PF-SP brakes,
-/// late" is not claimed here; a PF-SP obstacle that never slows counts as slowing never
-/// (later than any onset).
+/// The `paper` set: PF-SP brakes late; PF-ISO starts slowing earlier. In this reading the
+/// vehicle PF-ISO slows is the ego, not the obstacle: with the printed D_min the planning
+/// vehicle is always the follower, so the interaction term only slows the faster vehicle
+/// (docs/reproduction.md).
 #[test]
-fn paper_set_pf_iso_slows_before_pf_sp() {
+fn paper_set_pf_sp_brakes_later_than_pf_iso() {
     let scenario = variant(ParameterSet::Paper, Perturbation::Nominal);
     let [sp, iso] = run_kinds(&scenario, [PlannerKind::PfSp, PlannerKind::PfIso]);
-    let sp_onset = paper(&sp, OBSTACLE)
-        .slowing_onset_s
-        .unwrap_or(f64::INFINITY);
+    let sp_onset = paper(&sp, OBSTACLE).slowing_onset_s.expect("PF-SP brakes");
     let first = |o: &RunOutcome| {
         [EGO, OBSTACLE]
             .iter()
