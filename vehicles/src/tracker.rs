@@ -6,20 +6,11 @@
 //! L_d = clamp(L_min + T_la·v, L_min, L_max) growing with speed, and steer the bicycle arc through
 //! it: δ = atan(2 L sin α / l_d), α the bearing of the point relative to the heading, l_d its
 //! distance. Speed: the target is the speed of the path point nearest ahead of the CoG; the
-//! acceleration of that target along the plan's own timing is fed forward (below), and a PID
-//! with conditional-integration anti-windup corrects the rest. The acceleration demand
+//! profile's own acceleration v·dv/ds on the current path segment is fed forward, and a PID with
+//! conditional-integration anti-windup corrects the rest. The acceleration demand
 //! becomes drive torque on the driven axle or brake torque on all wheels (distributed in
 //! proportion to the estimated dynamic loads), each wheel's torque limited to what its tyre can
 //! transmit, μ·Fz·r.
-//!
-//! The feed-forward is the plan's speed change over a fixed window of its own time after the
-//! target point, a_ff = (v(t_a + W) − v(t_a)) / W, t_a the target point's planned time and v the
-//! plan's speed interpolated in its planned times (the reading of the recorded planned speed).
-//! It used to be v·dv/ds = (v_b² − v_a²) / (2 |ab|) on the segment the car was on: the ramp
-//! *into* the target's speed, fed forward while the target already was that speed, with the
-//! segment's length as the time scale. After a one-segment dip of PF-SP's plan (13.42 m/s on
-//! the first segment, then 14.62 m/s) it fed +2.75 m/s² to a car running 1.8 m/s above its plan,
-//! which accelerated; on the planner's sub-step segments (0.4 m) a 0.3 m/s step became 11 m/s².
 
 use serde::{Deserialize, Serialize};
 
@@ -50,11 +41,8 @@ pub struct TrackerParams {
     /// The error is integrated only while |error| is below this band (m/s), so large
     /// transients (handled by the proportional and feed-forward terms) do not wind it up.
     pub speed_integral_band_mps: f64,
-    /// Feed the plan's acceleration at the target point forward (module doc).
+    /// Use the speed profile's own acceleration v·dv/ds as a feed-forward term.
     pub speed_feedforward: bool,
-    /// Window W of planned time over which the feed-forward acceleration is taken (s): the plan's
-    /// speed change from the target point's planned time t_a to t_a + W, divided by W.
-    pub speed_feedforward_window_s: f64,
     /// Largest acceleration demand (m/s²).
     pub max_accel_mps2: f64,
     /// Largest deceleration demand (m/s², positive).
@@ -76,7 +64,6 @@ impl Default for TrackerParams {
             speed_kd: 0.0,
             speed_integral_band_mps: 1.0,
             speed_feedforward: true,
-            speed_feedforward_window_s: 0.4,
             max_accel_mps2: 3.0,
             max_decel_mps2: 8.0,
             friction_coefficient: 0.8,
@@ -94,7 +81,6 @@ pub const TRACKER_BOUNDS: &[Bound] = &[
     Bound::closed("speed_ki_per_s2", 0.0, 100.0, "1/s²"),
     Bound::closed("speed_kd", 0.0, 10.0, ""),
     Bound::closed("speed_integral_band_mps", 0.0, 20.0, "m/s"),
-    Bound::closed("speed_feedforward_window_s", 0.05, 5.0, "s"),
     Bound::above("max_accel_mps2", 0.0, 20.0, "m/s²"),
     Bound::above("max_decel_mps2", 0.0, 30.0, "m/s²"),
     Bound::closed("friction_coefficient", 0.05, 2.0, ""),
@@ -116,10 +102,6 @@ impl TrackerParams {
                 ("speed_ki_per_s2", self.speed_ki_per_s2),
                 ("speed_kd", self.speed_kd),
                 ("speed_integral_band_mps", self.speed_integral_band_mps),
-                (
-                    "speed_feedforward_window_s",
-                    self.speed_feedforward_window_s,
-                ),
                 ("max_accel_mps2", self.max_accel_mps2),
                 ("max_decel_mps2", self.max_decel_mps2),
                 ("friction_coefficient", self.friction_coefficient),
@@ -376,43 +358,6 @@ fn walk(path: &[mergesim_types::PathPoint], segment: usize, t: f64, distance_m: 
     }
 }
 
-/// The plan's speed at planned time `t_s`: the points' speeds interpolated linearly in their
-/// planned times, held before the first and after the last point (m/s).
-fn planned_speed_at_time(path: &[mergesim_types::PathPoint], t_s: f64) -> f64 {
-    let Some(first) = path.first() else {
-        return 0.0;
-    };
-    if t_s <= first.t_s {
-        return first.speed_mps;
-    }
-    for pair in path.windows(2) {
-        if t_s <= pair[1].t_s {
-            let span_s = pair[1].t_s - pair[0].t_s;
-            let w = if span_s > 0.0 {
-                (t_s - pair[0].t_s) / span_s
-            } else {
-                1.0
-            };
-            return pair[0].speed_mps + w * (pair[1].speed_mps - pair[0].speed_mps);
-        }
-    }
-    path.last().map_or(0.0, |p| p.speed_mps)
-}
-
-/// The feed-forward acceleration at path point `ahead` (m/s²): the plan's speed change over the
-/// window `window_s` of planned time after that point, divided by the window (module doc).
-/// Bounded by the plan's speed range over `window_s` (≥ 0.05 s), whatever its segment lengths;
-/// 0 for a non-finite or non-positive window or planned time.
-fn feedforward_mps2(path: &[mergesim_types::PathPoint], ahead: usize, window_s: f64) -> f64 {
-    let Some(point) = path.get(ahead) else {
-        return 0.0;
-    };
-    if !(window_s > 0.0 && window_s.is_finite() && point.t_s.is_finite()) {
-        return 0.0;
-    }
-    (planned_speed_at_time(path, point.t_s + window_s) - point.speed_mps) / window_s
-}
-
 fn wrap_angle(a: f64) -> f64 {
     let two_pi = std::f64::consts::TAU;
     let mut w = a.rem_euclid(two_pi);
@@ -503,13 +448,15 @@ impl Tracker {
             (seg_cog + 1).min(path.len() - 1)
         };
         let target_speed = path[ahead].speed_mps;
-        // Feed-forward: the target's own acceleration along the plan's timing.
-        let feedforward = if self.params.speed_feedforward {
-            feedforward_mps2(path, ahead, self.params.speed_feedforward_window_s)
+        // Feed-forward: the profile's acceleration on the current segment,
+        // v dv/ds = (v_b² − v_a²) / (2 |ab|).
+        let (a, b) = (&path[seg_cog], &path[seg_cog + 1]);
+        let segment_m = (b.x_m - a.x_m).hypot(b.y_m - a.y_m);
+        let feedforward = if self.params.speed_feedforward && segment_m > 1e-3 {
+            (b.speed_mps * b.speed_mps - a.speed_mps * a.speed_mps) / (2.0 * segment_m)
         } else {
             0.0
         };
-        let (a, b) = (&path[seg_cog], &path[seg_cog + 1]);
         let (drive, brake) =
             self.speed
                 .update_with_feedforward(target_speed, feedforward, kin.speed_mps, dt_s);
@@ -573,48 +520,6 @@ mod tests {
             "{} vs {expected}",
             controls.steer_rad
         );
-    }
-
-    fn timed(x: f64, v: f64, t: f64) -> mergesim_types::PathPoint {
-        mergesim_types::PathPoint {
-            x_m: x,
-            y_m: 0.0,
-            speed_mps: v,
-            t_s: t,
-        }
-    }
-
-    /// The cause of the accelerating car: PF-SP's one-segment dip (13.42 m/s on the first
-    /// segment, 14.62 then 15 m/s), with the planner's 0.4 m sub-step segments after it. The old
-    /// feed-forward, v·dv/ds on the car's segment, fed +2.75 m/s² (the ramp into the target's
-    /// speed) and 10–11 m/s² on a sub-step; the new one is the target's own change over 0.4 s of
-    /// planned time, bounded by the plan's speed range over the window.
-    #[test]
-    fn feedforward_is_the_targets_change_over_a_window_of_planned_time() {
-        let path = [
-            timed(0.0, 13.416, 0.0),
-            timed(6.12, 14.616, 0.456),
-            timed(12.23, 15.0, 0.874),
-            timed(18.41, 15.0, 1.286),
-            timed(18.81, 14.7, 1.313),
-            timed(19.21, 14.7, 1.340),
-        ];
-        let window_s = 0.4;
-        // At the target point 1: 14.616 → 15 over 0.418 s, sampled at 0.4 s.
-        let ff = feedforward_mps2(&path, 1, window_s);
-        let expected = (14.616 + 0.384 * 0.4 / 0.418 - 14.616) / 0.4;
-        assert!((ff - expected).abs() < 1e-12, "{ff} vs {expected}");
-        assert!(ff > 0.0 && ff < 1.0, "{ff}");
-        // On the sub-steps: a 0.3 m/s drop over 27 ms of planned time stays within its share of
-        // the window, and slows.
-        let ff = feedforward_mps2(&path, 3, window_s);
-        assert!(ff < 0.0 && ff >= -0.3 / window_s - 1e-12, "{ff}");
-        // A flat plan feeds nothing forward; a non-finite time feeds nothing either.
-        let flat = [timed(0.0, 15.0, 0.0), timed(6.0, 15.0, 0.4)];
-        assert_eq!(feedforward_mps2(&flat, 1, window_s), 0.0);
-        let mut broken = flat;
-        broken[1].t_s = f64::NAN;
-        assert_eq!(feedforward_mps2(&broken, 1, window_s), 0.0);
     }
 
     #[test]
