@@ -3,7 +3,7 @@
 //! the caller as it finishes (the CLI appends it to the JSONL); resumable from those rows.
 //!
 //! Sharding and seeds are the sweep's: instance i runs with
-//! [`instance_seed`](crate::sweep::instance_seed)`(K, i)` and shard `i/n` runs the instance
+//! [`crate::sweep::instance_seed`]`(K, i)` and shard `i/n` runs the instance
 //! block [`Shard::instances`] of every cell and planner. The rows are sorted by (cell, planner,
 //! instance) before any figure is computed from them, so the report does not depend on the
 //! thread count, the scheduling, the sharding or the resumption.

@@ -37,7 +37,7 @@ const VIRIDIS: [[u8; 3]; 9] = [
 /// output that draws vehicles: the Rerun recording, the PNG figures (`merge_sim compare
 /// --plots`) and the GIF (`merge_sim run --gif`), so a vehicle has the same RGB in all three.
 ///
-/// Ids 0 to 7 take [`VEHICLE_PALETTE`] (the paper's green ego and blue obstacle first); later
+/// Ids 0 to 7 take the eight colours of `VEHICLE_PALETTE` (the paper's green ego and blue obstacle first); later
 /// ids take hues spaced by the golden angle, at three lightness levels, so no two ids below
 /// [`DISTINCT_VEHICLE_COLORS`] share a colour and none is a grey (the road's colours).
 pub fn vehicle_color(id: VehicleId) -> [u8; 3] {
