@@ -140,10 +140,12 @@ fn non_finite(what: &str) -> PlannerError {
     PlannerError::NonFinite { what: what.into() }
 }
 
-/// Speed of `path` at absolute time `t_s` (the speed held from the last point reached).
+/// Speed of `path` at absolute time `t_s`: that of the next point (a point carries the speed
+/// reached there, i.e. of the step ending at it).
 fn speed_at_time(path: &[PathPoint], t_s: f64) -> Option<f64> {
     let k = path.partition_point(|p| p.t_s <= t_s);
-    path.get(k.saturating_sub(1)).map(|p| p.speed_mps)
+    path.get(k.min(path.len().saturating_sub(1)))
+        .map(|p| p.speed_mps)
 }
 
 /// A cycle's failure, with whatever was computed before it (for the fallback).
@@ -468,13 +470,16 @@ impl PfPlanner {
             }
         };
 
-        // The path to track and the SLP: t_i = t_0 + Σ Δs_j / v_j.
+        // The path to track and the SLP: t_i = t_0 + Σ Δs_j / v_j. The profile starts at the
+        // current speed v_0 at t_0 and reaches v_i at point i (the speed of step i is its value
+        // at the step's end, as the bound |v_i − v_{i−1}| ≤ a_max Δt assumes): the first point
+        // carries v_0, not v_1, so the plan is no step a car cannot follow.
         let mut path = Vec::with_capacity(n + 1);
         let mut t_s = req.time_s;
         path.push(PathPoint {
             x_m: req.ego.x_m,
             y_m: req.ego.y_m,
-            speed_mps: speeds_mps[0],
+            speed_mps: req.ego.speed_mps.max(0.0),
             t_s,
         });
         for (k, p) in points.iter().enumerate() {
@@ -482,7 +487,7 @@ impl PfPlanner {
             path.push(PathPoint {
                 x_m: p[0],
                 y_m: p[1],
-                speed_mps: speeds_mps[(k + 1).min(n - 1)],
+                speed_mps: speeds_mps[k],
                 t_s,
             });
         }

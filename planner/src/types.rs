@@ -40,7 +40,7 @@ impl Plan {
     /// `now` (kinematic roll-outs in tests and examples; the simulator moves its vehicles with
     /// a tracker and tyres instead): position and heading interpolated along the timed path,
     /// speed ramping from `now`'s speed to the first planned speed over the first segment and
-    /// then the planned speed of the segment. A plan with fewer than two points leaves `now`
+    /// then the planned speed of the segment (the speed its end point carries). A plan with fewer than two points leaves `now`
     /// unchanged.
     pub fn kinematic_state_at(&self, now: &VehicleState, t_s: f64) -> VehicleState {
         let path = &self.path;
@@ -53,9 +53,9 @@ impl Plan {
         let (a, b) = (path[k - 1], path[k]);
         let f = ((t_s - a.t_s) / (b.t_s - a.t_s)).clamp(0.0, 1.0);
         let speed_mps = if k == 1 {
-            now.speed_mps + f * (a.speed_mps - now.speed_mps)
+            now.speed_mps + f * (b.speed_mps - now.speed_mps)
         } else {
-            a.speed_mps
+            b.speed_mps
         };
         VehicleState {
             x_m: a.x_m + f * (b.x_m - a.x_m),
@@ -104,8 +104,8 @@ mod tests {
             speed_mps: 8.0,
         };
         let plan = plan_through(&[
-            (0.0, 0.0, 0.0, 10.0),
-            (1.0, 10.0, 0.0, 12.0),
+            (0.0, 0.0, 0.0, 8.0),
+            (1.0, 10.0, 0.0, 10.0),
             (2.0, 20.0, 10.0, 12.0),
         ]);
         // First segment: halfway in position, speed halfway from 8 to the first planned 10.

@@ -71,8 +71,9 @@ fn plan_starts_at_the_vehicle_with_times_from_distance_over_speed() {
     );
     for w in plan.path.windows(2) {
         let ds = ((w[1].x_m - w[0].x_m).powi(2) + (w[1].y_m - w[0].y_m).powi(2)).sqrt();
-        // Segment k is driven at the speed held from its first point.
-        assert!((w[1].t_s - w[0].t_s - ds / w[0].speed_mps).abs() < 1e-9);
+        // Segment k is driven at the speed its end point carries; the first point carries the
+        // vehicle's speed.
+        assert!((w[1].t_s - w[0].t_s - ds / w[1].speed_mps).abs() < 1e-9);
     }
     // The broadcast carries the same timed points.
     assert_eq!(plan.shared.waypoints.len(), plan.path.len());
@@ -150,7 +151,7 @@ fn curvature_caps_the_speed_in_a_bend() {
             .abs()
             .max(textbook_curvature(plan.cubic, plan.cubic_x_scale_m, xis[k + 1]).abs());
         let friction_limit = (req.mu * GRAVITY_MPS2 / kappa).sqrt();
-        let v = plan.path[k].speed_mps;
+        let v = plan.path[k + 1].speed_mps;
         assert!(
             v <= friction_limit + 1e-6,
             "segment {k}: {v} > {friction_limit}"

@@ -57,8 +57,12 @@ proptest! {
             let plan = planner.plan(&req).unwrap();
             prop_assert_eq!(plan.path.len(), params.waypoint_count + 1);
             prop_assert_eq!((plan.path[0].x_m, plan.path[0].y_m), (ego.x_m, ego.y_m));
+            // The first point carries the vehicle's speed, the others the planned ones.
+            prop_assert_eq!(plan.path[0].speed_mps, ego.speed_mps.max(0.0));
             for p in &plan.path {
                 prop_assert!(p.x_m.is_finite() && p.y_m.is_finite() && p.t_s.is_finite());
+            }
+            for p in &plan.path[1..] {
                 prop_assert!(p.speed_mps >= 0.0 && p.speed_mps <= params.speed_limit_mps + 1e-9,
                     "speed {} out of bounds", p.speed_mps);
                 if plan.fallback.is_none() {

@@ -12,9 +12,11 @@ pub struct PathPoint {
     pub x_m: f64,
     /// Position (m).
     pub y_m: f64,
-    /// Planned speed on the segment from this point to the next (m/s): the times follow
-    /// t_{k+1} = t_k + Δs_k / v_k. The tracker aims at the speed of the point ahead of the
-    /// vehicle, i.e. the next segment's, which previews the profile by one segment.
+    /// Planned speed on reaching this point (m/s): the first point carries the vehicle's speed
+    /// v_0 at the plan's time, point k the speed v_k of the step ending at it (the segment to
+    /// it is driven at v_k: t_k = t_{k−1} + Δs / v_k); linear in time in between, the profile
+    /// starts where the vehicle is. The tracker aims at the speed of the point ahead of the
+    /// vehicle, i.e. the end of its segment.
     pub speed_mps: f64,
     /// Planned absolute arrival time (s).
     pub t_s: f64,
