@@ -70,6 +70,7 @@ mod tests {
             target_speed_mps: 20.0,
             mu: 0.8,
             road: &road,
+            lanes: &road.lane_road().unwrap(),
             neighbours: &[],
             shared_paths: &[],
         };

@@ -23,6 +23,9 @@ pub enum SimError {
     /// Something about the scenario's vehicles is inconsistent (duplicate ids, ...).
     #[error("invalid scenario: {0}")]
     InvalidScenario(String),
+    /// The road's lanes are inconsistent (the error names the lane and what is wrong).
+    #[error("road: {0}")]
+    Road(#[from] mergesim_types::lanes::LaneError),
     /// The vehicle model refused its parameters or state.
     #[error(transparent)]
     Vehicle(#[from] vehicles::VehicleError),

@@ -46,6 +46,8 @@ pub struct RunOptions {
 /// The simulation.
 pub struct World {
     config: SimConfig,
+    /// The road as lanes, built once from `config.road` (shared with the observations).
+    lanes: std::sync::Arc<mergesim_types::lanes::LaneRoad>,
     physics: PhysicsWorld,
     agents: Vec<Agent>,
     bus: V2vBus,
@@ -102,6 +104,7 @@ impl World {
     ) -> Result<Self, SimError> {
         config.validate()?;
         crate::config::validate_vehicles(&config, specs)?;
+        let lanes = std::sync::Arc::new(config.road.lane_road()?);
         let mut physics = PhysicsWorld::new(config.dt_s)?;
         physics.add_merge_road(&config.road);
         let mut agents = Vec::with_capacity(specs.len());
@@ -134,6 +137,7 @@ impl World {
             steps_per_field: steps_for(config.field_log_period_s, config.dt_s),
             steps_per_safety: steps_for(config.safety_period_s, config.dt_s),
             config,
+            lanes,
             physics,
             agents,
             bus,

@@ -27,6 +27,7 @@
 //! ```
 
 use crate::grid::GridSpec;
+use crate::lanes::LaneRoad;
 use crate::path::{PathPoint, SharedLocalPath};
 use crate::road::MergeRoad;
 use crate::vehicle::{Neighbour, VehicleId, VehicleShape, VehicleState};
@@ -49,8 +50,12 @@ pub struct Observation<'a> {
     pub target_speed_mps: f64,
     /// Tire–road friction μ.
     pub mu: f64,
-    /// The road.
+    /// The road's parametric description (the paper's straight merge road) that [`Self::lanes`]
+    /// was built from. Being replaced by `lanes` in every consumer; read `lanes` in new code.
     pub road: &'a MergeRoad,
+    /// The road as lanes: centrelines with their (s, d) frames, bounds, links, dividers, outer
+    /// edges and lane ends. Planners, metrics and safety checks read the road through it.
+    pub lanes: &'a LaneRoad,
     /// The current state of every other vehicle within the perception range (the simulator's
     /// `perception_range_m`, 250 m by default), in id order.
     pub neighbours: &'a [Neighbour],
