@@ -183,7 +183,11 @@ impl EnvCore {
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner) = Command {
             target_speed_mps: agent_spec.target_speed_mps,
-            target_y_m: instance.sim.road.lane_center_y_m(agent_spec.lane) + agent_spec.y_offset_m,
+            target_y_m: instance
+                .sim
+                .road
+                .lane_center_y_m(agent_spec.lane.merge_lane().unwrap_or(sim::Lane::Lower))
+                + agent_spec.y_offset_m,
         };
         *self
             .contacts

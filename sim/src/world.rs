@@ -17,6 +17,7 @@ use crate::agent::Agent;
 use crate::config::{SimConfig, VehicleSpec};
 use crate::drivers::lane_path;
 use crate::error::SimError;
+use crate::lane_membership::{lane_change, lane_of};
 use crate::metrics::{MetricsSample, VehicleMetrics};
 use crate::observer::{TickObserver, VehicleView};
 use crate::outcome::{PlannerStats, RunOutcome};
@@ -46,7 +47,8 @@ pub struct RunOptions {
 /// The simulation.
 pub struct World {
     config: SimConfig,
-    /// The road as lanes, built once from `config.road` (shared with the observations).
+    /// The road as lanes, built once from `config.lane_road` or else `config.road` (shared with
+    /// the observations and the metrics).
     lanes: std::sync::Arc<mergesim_types::lanes::LaneRoad>,
     physics: PhysicsWorld,
     agents: Vec<Agent>,
@@ -68,9 +70,16 @@ pub struct World {
     steps_per_safety: u64,
     reported_collisions: usize,
     reported_edge_contacts: usize,
+    /// False on a road of lanes: the parry road-edge test still reads the straight `[sim.road]`
+    /// edges, which are not this road's, so its contacts are dropped until the edge test is
+    /// built from the lanes.
+    straight_edges: bool,
     profiler: Profiler,
     planning_pool: Option<std::sync::Arc<rayon::ThreadPool>>,
 }
+
+/// How far the flat surface under a road of lanes reaches beyond its lanes' centrelines (m).
+const FLAT_GROUND_MARGIN_M: f64 = 200.0;
 
 fn steps_for(period_s: f64, dt_s: f64) -> u64 {
     ((period_s / dt_s).round() as u64).max(1)
@@ -104,13 +113,24 @@ impl World {
     ) -> Result<Self, SimError> {
         config.validate()?;
         crate::config::validate_vehicles(&config, specs)?;
-        let lanes = std::sync::Arc::new(config.road.lane_road()?);
+        let lanes = std::sync::Arc::new(config.lanes()?);
         let mut physics = PhysicsWorld::new(config.dt_s)?;
-        physics.add_merge_road(&config.road);
+        if config.is_straight_merge_road() {
+            physics.add_merge_road(&config.road);
+        } else {
+            // A road of lanes: a flat surface under all of it (the lanes' collider and barriers
+            // come with the lane-geometry road collider).
+            let reach_m = lanes.lanes().iter().fold(0.0_f64, |r, l| {
+                let [lo, hi] = l.centreline().bounding_box_m();
+                r.max(lo[0].abs()).max(lo[1].abs()).max(hi[0].abs()).max(hi[1].abs())
+            });
+            physics.add_flat_ground(reach_m + FLAT_GROUND_MARGIN_M);
+        }
         let mut agents = Vec::with_capacity(specs.len());
         for (index, spec) in specs.iter().enumerate() {
             agents.push(Agent::spawn(
                 &config,
+                &lanes,
                 &mut physics,
                 index,
                 spec,
@@ -127,7 +147,7 @@ impl World {
             .iter()
             .map(|a| {
                 VehicleMetrics::new(a.spec.name.clone())
-                    .with_paper_metrics(&config.road, a.spec.target_speed_mps)
+                    .with_paper_metrics(lanes.clone(), a.spec.target_speed_mps)
             })
             .collect();
         let recording = RecordingObserver::new(recorder, &config.road)?;
@@ -136,6 +156,7 @@ impl World {
             steps_per_log: steps_for(config.log_period_s, config.dt_s),
             steps_per_field: steps_for(config.field_log_period_s, config.dt_s),
             steps_per_safety: steps_for(config.safety_period_s, config.dt_s),
+            straight_edges: config.is_straight_merge_road(),
             config,
             lanes,
             physics,
@@ -245,10 +266,10 @@ impl World {
             if agent.path.is_empty() {
                 let v = agent.spec.target_speed_mps;
                 agent.path = lane_path(
-                    &self.config.road,
-                    agent.spec.lane,
+                    &self.lanes,
+                    agent.spec.lane.id(),
                     agent.spec.y_offset_m,
-                    kin.x_m,
+                    [kin.x_m, kin.y_m],
                     t_s,
                     |_| v,
                 );
@@ -283,12 +304,16 @@ impl World {
                 .collect();
             for (agent, kin) in self.agents.iter().zip(&kins) {
                 check_finite(t_s, &agent.spec.name, kin)?;
-                let front_m = kin.x_m + 0.5 * agent.vehicle.params().length_m;
-                if front_m > self.config.road.end_x_m {
+                if let Some(lane) = past_road_end(
+                    &self.lanes,
+                    agent.lane,
+                    kin,
+                    0.5 * agent.vehicle.params().length_m,
+                ) {
                     return Err(SimError::RoadEnd {
                         vehicle: agent.spec.name.clone(),
                         t_s,
-                        end_x_m: self.config.road.end_x_m,
+                        lane,
                     });
                 }
             }
@@ -380,6 +405,9 @@ impl World {
             })?;
             self.reported_collisions += 1;
         }
+        if !self.straight_edges {
+            self.reported_edge_contacts = self.safety.edge_contact_events().len();
+        }
         while self.reported_edge_contacts < self.safety.edge_contact_events().len() {
             let event = self.safety.edge_contact_events()[self.reported_edge_contacts].clone();
             let name = names.get(event.id as usize).cloned().unwrap_or_default();
@@ -408,18 +436,19 @@ impl World {
         bodies: &[BodyState],
     ) -> Result<(), SimError> {
         // Lane changes first (events), then the observers.
-        let y_lane_m = self.config.road.y_lane_m();
-        let mut crossings = Vec::new();
+        let mut changes = Vec::new();
         for (agent, k) in self.agents.iter_mut().zip(kins) {
-            if !agent.merged && k.y_m > y_lane_m {
-                agent.merged = true;
-                crossings.push(format!(
-                    "t = {t_s:.2} s: {} crossed the lane divider at x = {:.1} m",
-                    agent.spec.name, k.x_m
+            let hit = lane_of(&self.lanes, Some(agent.lane), [k.x_m, k.y_m]);
+            if let Some(direction) = lane_change(&self.lanes, agent.lane, hit.lane) {
+                changes.push(format!(
+                    "t = {t_s:.2} s: {} changed lanes {direction}, from lane {} to lane {}, at \
+                     x = {:.1} m, y = {:.1} m",
+                    agent.spec.name, agent.lane, hit.lane, k.x_m, k.y_m
                 ));
             }
+            agent.lane = hit.lane;
         }
-        for text in crossings {
+        for text in changes {
             self.event(text, EventLevel::Info)?;
         }
         let samples: Vec<MetricsSample> = kins
@@ -481,7 +510,10 @@ impl World {
     }
 
     fn finish(mut self) -> Result<RunOutcome, SimError> {
-        let safety = self.safety.summary();
+        let mut safety = self.safety.summary();
+        if !self.straight_edges {
+            safety.edge_contacts.clear();
+        }
         if safety.near_miss {
             let text = format!(
                 "near miss: min gap {} m, min TTC {}",
@@ -522,6 +554,27 @@ impl World {
             events: self.events,
         })
     }
+}
+
+/// The lane whose open end (the road's end) the vehicle's front has passed, if any: the front
+/// (the centre of gravity + `half_length_m` along the heading) lies beyond the end of the lane
+/// the vehicle is in, and that lane ends without successors, open. On the straight merge road:
+/// the front past `road.end_x_m`.
+fn past_road_end(
+    lanes: &mergesim_types::lanes::LaneRoad,
+    current: mergesim_types::lanes::LaneId,
+    k: &Kinematics,
+    half_length_m: f64,
+) -> Option<mergesim_types::lanes::LaneId> {
+    let hit = lane_of(lanes, Some(current), [k.x_m, k.y_m]);
+    let lane = lanes.lane(hit.lane)?;
+    let open_end = lanes.lane_end(hit.lane).is_some_and(|e| !e.closed);
+    if !open_end {
+        return None;
+    }
+    let (s, c) = k.yaw_rad.sin_cos();
+    let front_m = [k.x_m + half_length_m * c, k.y_m + half_length_m * s];
+    (lane.project(front_m).s_m > lane.length_m()).then_some(hit.lane)
 }
 
 fn percentile(sorted: &[f64], q: f64) -> f64 {
