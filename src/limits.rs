@@ -6,6 +6,7 @@
 //! test keeps the two equal.
 
 use mergesim_types::bounds::{Bound, markdown_rows};
+use mergesim_types::lanes::{CURVED_MERGE_RADIUS_M, ON_RAMP_BOUNDS};
 use mergesim_types::road::{MERGE_SECTION_LENGTH_M, ROAD_BOUNDS};
 use planner::params::{MAX_WAYPOINTS, MIN_WAYPOINTS, PLANNER_BOUNDS};
 use scenarios::scenario::ROAD_END_SPEED_ALLOWANCE;
@@ -23,6 +24,7 @@ pub fn scenario_tables() -> Vec<(&'static str, &'static [Bound])> {
     vec![
         ("sim", SIM_BOUNDS),
         ("sim.road", ROAD_BOUNDS),
+        ("sim.lane_road.on_ramp", ON_RAMP_BOUNDS),
         ("sim.planner", PLANNER_BOUNDS),
         ("sim.tracker", TRACKER_BOUNDS),
         ("sim.safety", SAFETY_BOUNDS),
@@ -53,6 +55,19 @@ pub fn other_limits() -> Vec<(String, String)> {
         (
             "merge section `merge_end_x_m − merge_start_x_m`".into(),
             format!("{merge_min_m} to {merge_max_m} m"),
+        ),
+        (
+            "`[sim.lane_road]` `curved_merge.radius_m`".into(),
+            format!(
+                "|radius| {} to {} m, and at least the road's length / 6",
+                CURVED_MERGE_RADIUS_M[0], CURVED_MERGE_RADIUS_M[1]
+            ),
+        ),
+        (
+            "`[sim.lane_road]` lanes".into(),
+            "consistent (ids, links, widths > 0, ≥ 2 distinct vertices, turns ≤ 90°); \
+             `on_ramp.main_length_m` past the acceleration lane's end"
+                .into(),
         ),
         (
             "`[sim.idm]` decelerations".into(),

@@ -602,6 +602,15 @@ impl Scenario {
         let base = toml::Table::try_from(self.params.planner_params())
             .map_err(|e| error(e.to_string()))?;
         if let Some(sim) = table.get_mut("sim").and_then(|v| v.as_table_mut()) {
+            // A road of lanes that does not bend `[sim.road]` stands alone (check_one_road).
+            if self
+                .sim
+                .lane_road
+                .as_ref()
+                .is_some_and(|c| !c.is_merge_road())
+            {
+                sim.remove("road");
+            }
             let differing: toml::Table = match sim.get("planner").and_then(|p| p.as_table()) {
                 Some(planner) => planner
                     .iter()
