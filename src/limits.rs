@@ -59,7 +59,7 @@ pub fn other_limits() -> Vec<(String, String)> {
         (
             "`[sim.lane_road]` `curved_merge.radius_m`".into(),
             format!(
-                "|radius| {} to {} m, and at least the road's length / 6",
+                "absolute radius {} to {} m, and at least the road's length / 6",
                 CURVED_MERGE_RADIUS_M[0], CURVED_MERGE_RADIUS_M[1]
             ),
         ),
@@ -86,20 +86,24 @@ pub fn other_limits() -> Vec<(String, String)> {
         ),
         (
             "`[[vehicles]]` `x_m`".into(),
-            "on the road: in [`start_x_m`, `end_x_m`]".into(),
+            "on the road: in [`start_x_m`, `end_x_m`]; on a `[sim.lane_road]`, the arc length \
+             along its lane, in [0, the lane's length]"
+                .into(),
         ),
         (
             "`[[vehicles]]` body at spawn".into(),
             "on the road surface (between the edges, within its length), not overlapping \
              another body, a lower-lane front before `merge_end_x_m` — over the whole \
-             randomisation box"
+             randomisation box; on a `[sim.lane_road]`, its corners on the lanes and no \
+             overlap (oriented boxes)"
                 .into(),
         ),
         (
             "road length".into(),
             format!(
                 "every vehicle's front + `duration_s` × (its highest initial, target or \
-                 prescribed speed, randomisation included) × {} ≤ `end_x_m`",
+                 prescribed speed, randomisation included) × {} ≤ `end_x_m` (not checked on a \
+                 `[sim.lane_road]`)",
                 1.0 + ROAD_END_SPEED_ALLOWANCE
             ),
         ),

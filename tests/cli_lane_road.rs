@@ -66,11 +66,15 @@ fn the_binary_refuses_inconsistent_lanes_with_file_line_field_and_exit_2() {
         "[[-50.0, 5.25], [-50.0, 5.25]]",
         "lane_road.lanes[0].centreline_m",
     );
-    let duplicate = URGENT_AS_LANES.replacen("id = 2\n", "id = 1\nkind = \"exit\"\n", 1);
+    let duplicate = URGENT_AS_LANES.replacen(
+        "id = 2\n",
+        "id = 1 # the duplicate\n",
+        1,
+    );
     assert_cli_refuses(
         "lanes_duplicate_id",
         &duplicate,
-        "kind = \"exit\"",
+        "# the duplicate",
         "lane_road.lanes[1].id",
     );
 }

@@ -119,6 +119,16 @@ impl EnvCore {
         vehicle: Option<&str>,
     ) -> PyResult<Self> {
         let scenario = source::load(scenario, params_json)?;
+        // The environment's observations, commands and rendering are those of the straight
+        // merge road (x along it, y across it); a road of lanes is refused, not misread.
+        if !scenario.sim.is_straight_merge_road() {
+            return Err(BindingError::Input(format!(
+                "scenario {}: MergeEnv runs on the straight [sim.road] merge road only; this \
+                 scenario's road is a [sim.lane_road]",
+                scenario.name
+            ))
+            .into());
+        }
         let names: Vec<&str> = scenario.vehicles.iter().map(|v| v.name.as_str()).collect();
         let agent = match vehicle {
             Some(name) => names.iter().position(|n| *n == name).ok_or_else(|| {
