@@ -66,11 +66,7 @@ fn the_binary_refuses_inconsistent_lanes_with_file_line_field_and_exit_2() {
         "[[-50.0, 5.25], [-50.0, 5.25]]",
         "lane_road.lanes[0].centreline_m",
     );
-    let duplicate = URGENT_AS_LANES.replacen(
-        "id = 2\n",
-        "id = 1 # the duplicate\n",
-        1,
-    );
+    let duplicate = URGENT_AS_LANES.replacen("id = 2\n", "id = 1 # the duplicate\n", 1);
     assert_cli_refuses(
         "lanes_duplicate_id",
         &duplicate,
@@ -143,6 +139,9 @@ fn the_new_builtins_load_and_a_run_starts() {
         assert!(out.status.success(), "{name}: {}", stderr(&out));
         let v: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-        assert!((v["duration_s"].as_f64().unwrap() - 4.0).abs() < 1e-9, "{v}");
+        assert!(
+            (v["duration_s"].as_f64().unwrap() - 4.0).abs() < 1e-9,
+            "{v}"
+        );
     }
 }

@@ -42,7 +42,8 @@ fn registry() -> BehaviourRegistry {
             Arc::new(|input: &FactoryInput<'_>| {
                 Ok(Box::new(FixedSpeed {
                     speed_mps: 12.0,
-                    lane: input.spec.lane,
+                    // The merge road's lanes by name ("lower" / "upper" or ids 2 / 1).
+                    lane: input.spec.lane.merge_lane().unwrap(),
                 }) as Box<dyn Behaviour>)
             }),
         )

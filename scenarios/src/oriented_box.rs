@@ -57,10 +57,11 @@ impl OrientedBox {
         let (ca, cb) = (self.corners(), other.corners());
         axes.iter().all(|ax| {
             let project = |cs: &[[f64; 2]; 4]| {
-                cs.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], c| {
-                    let p = c[0] * ax[0] + c[1] * ax[1];
-                    [lo.min(p), hi.max(p)]
-                })
+                cs.iter()
+                    .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], c| {
+                        let p = c[0] * ax[0] + c[1] * ax[1];
+                        [lo.min(p), hi.max(p)]
+                    })
             };
             let ([a0, a1], [b0, b1]) = (project(&ca), project(&cb));
             a0 < b1 && b0 < a1

@@ -3,9 +3,9 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+use mergesim_types::lanes::LaneError;
 use planner::{Lane, ParameterSet, PlannerParams};
 use serde::{Deserialize, Serialize};
-use mergesim_types::lanes::LaneError;
 use sim::{SimConfig, SimError, VehicleSpec};
 use thiserror::Error;
 
@@ -425,7 +425,12 @@ impl Scenario {
     /// `[[sim.lane_road.lanes]]` (the second one for a duplicate id) and its field (with the
     /// vertex index where the error names one), or `[sim.lane_road]` for a generated road.
     fn lane_error_path(&self, e: &LaneError) -> (Vec<String>, String) {
-        let lanes = self.sim.lane_road.as_ref().map(|c| &c.lanes[..]).unwrap_or(&[]);
+        let lanes = self
+            .sim
+            .lane_road
+            .as_ref()
+            .map(|c| &c.lanes[..])
+            .unwrap_or(&[]);
         let mut path = vec!["sim".to_string(), "lane_road".to_string()];
         let index = e.lane().and_then(|id| {
             let mut matches = lanes.iter().enumerate().filter(|(_, l)| l.id == id);
@@ -447,7 +452,11 @@ impl Scenario {
             path.push("lanes".into());
             return (path, "lane_road.lanes".into());
         };
-        path.extend(["lanes".to_string(), index.to_string(), e.field().to_string()]);
+        path.extend([
+            "lanes".to_string(),
+            index.to_string(),
+            e.field().to_string(),
+        ]);
         let vertex = match e {
             LaneError::NonFinite { index, .. }
             | LaneError::SharpTurn { index, .. }
@@ -504,19 +513,26 @@ impl Scenario {
             let params = vehicles::VehicleParams::preset(&v.preset)
                 .map_err(|e| invalid("preset", e.to_string()))?;
             let Some(lane) = lanes.lane(v.lane.id()) else {
-                return Err(invalid("lane", format!("lane {} is not on the road", v.lane)));
+                return Err(invalid(
+                    "lane",
+                    format!("lane {} is not on the road", v.lane),
+                ));
             };
             let b = self.randomise.vehicle_bounds(&v.name);
             let (half_l, half_w) = (0.5 * params.length_m, 0.5 * params.width_m);
             let s_range = [v.x_m + b.x_m[0], v.x_m + b.x_m[1]];
-            let d_range = [v.y_offset_m + b.y_offset_m[0], v.y_offset_m + b.y_offset_m[1]];
+            let d_range = [
+                v.y_offset_m + b.y_offset_m[0],
+                v.y_offset_m + b.y_offset_m[1],
+            ];
             // Corners at every metre of the s range (and its ends), at both ends of the d range.
             let steps = ((s_range[1] - s_range[0]).ceil().max(0.0) as usize).min(10_000) + 1;
             for k in 0..=steps {
                 let s = s_range[0] + (s_range[1] - s_range[0]) * k as f64 / steps as f64;
                 for d in d_range {
                     let body = OrientedBox::on_lane(lane, s, d, half_l, half_w);
-                    if let Some(corner) = body.corners().into_iter().find(|c| !lanes.is_drivable(*c))
+                    if let Some(corner) =
+                        body.corners().into_iter().find(|c| !lanes.is_drivable(*c))
                     {
                         // Off the side with the nominal offset too: the position along the lane is
                         // the cause.

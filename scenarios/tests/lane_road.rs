@@ -47,13 +47,7 @@ fn assert_refused(text: &str, needle: &str, field: &str, words: &str) {
 #[test]
 fn lanes_written_out_give_the_merge_roads_lanes() {
     let s = Scenario::from_toml(URGENT_AS_LANES, "lanes.toml").unwrap();
-    let spec = s
-        .sim
-        .lane_road
-        .as_ref()
-        .unwrap()
-        .spec(&s.sim.road)
-        .unwrap();
+    let spec = s.sim.lane_road.as_ref().unwrap().spec(&s.sim.road).unwrap();
     assert_eq!(spec, MergeRoad::default().lane_road_spec());
     let lanes = s.sim.lanes().unwrap();
     assert_eq!(lanes.lanes().len(), 2);
@@ -234,9 +228,11 @@ fn a_vehicle_off_the_road_is_refused() {
 
 #[test]
 fn a_bad_generated_road_parameter_is_named() {
-    let text = scenarios::builtin::toml_of("on_ramp")
-        .unwrap()
-        .replacen("ramp_radius_m = 150.0", "ramp_radius_m = 5.0", 1);
+    let text = scenarios::builtin::toml_of("on_ramp").unwrap().replacen(
+        "ramp_radius_m = 150.0",
+        "ramp_radius_m = 5.0",
+        1,
+    );
     let (line, field, message) = refusal(&text);
     assert_eq!(
         field.as_deref(),

@@ -18,8 +18,8 @@ pub mod profile;
 pub mod recording;
 pub mod recording_observer;
 pub mod registry;
-pub mod road_config;
 pub mod rng;
+pub mod road_config;
 pub mod run_log;
 pub mod safety;
 pub mod spatial;
@@ -35,6 +35,6 @@ pub use mergesim_types::{
 };
 pub use observer::{PlanView, TickObserver, VehicleView};
 pub use outcome::{PlannerStats, RunOutcome, TimeSeriesRow};
-pub use road_config::{LaneRoadConfig, StartLane};
 pub use registry::{BehaviourFactory, BehaviourRegistry, FactoryInput};
+pub use road_config::{LaneRoadConfig, StartLane};
 pub use world::{RunOptions, World};

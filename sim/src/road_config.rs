@@ -178,7 +178,10 @@ impl Visitor<'_> for StartLaneVisitor {
     type Value = StartLane;
 
     fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "\"lower\", \"upper\" or a lane id (a non-negative integer)")
+        write!(
+            f,
+            "\"lower\", \"upper\" or a lane id (a non-negative integer)"
+        )
     }
 
     fn visit_str<E: de::Error>(self, v: &str) -> Result<StartLane, E> {

@@ -122,7 +122,10 @@ impl World {
             // come with the lane-geometry road collider).
             let reach_m = lanes.lanes().iter().fold(0.0_f64, |r, l| {
                 let [lo, hi] = l.centreline().bounding_box_m();
-                r.max(lo[0].abs()).max(lo[1].abs()).max(hi[0].abs()).max(hi[1].abs())
+                r.max(lo[0].abs())
+                    .max(lo[1].abs())
+                    .max(hi[0].abs())
+                    .max(hi[1].abs())
             });
             physics.add_flat_ground(reach_m + FLAT_GROUND_MARGIN_M);
         }

@@ -93,7 +93,10 @@ fn events_of(config: SimConfig, x_m: f64) -> (Vec<String>, u32) {
 }
 
 fn assert_down_and_back(events: &[String], crossings: u32, what: &str) {
-    let changes: Vec<&String> = events.iter().filter(|e| e.contains("changed lanes")).collect();
+    let changes: Vec<&String> = events
+        .iter()
+        .filter(|e| e.contains("changed lanes"))
+        .collect();
     assert_eq!(changes.len(), 2, "{what}: {events:?}");
     assert!(
         changes[0].contains("weaver changed lanes right, from lane 1 to lane 2"),
