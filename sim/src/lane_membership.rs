@@ -80,8 +80,10 @@ pub struct MergeZone {
     pub along: LaneId,
     /// The zone as arc lengths along `along` (m).
     pub s_m: [f64; 2],
-    /// The world x of the zone's two ends (m): on the straight merge road, the merge section's
-    /// start and its end + [`MERGE_ZONE_TAIL_M`].
+    /// The world x of the zone's two ends (m): the taper's start, and the point
+    /// [`MERGE_ZONE_TAIL_M`] past the lane's end straight on along its end direction (on the
+    /// straight merge road, the merge section's start and its end + 20 m; on a curve the zone
+    /// itself is `s_m`).
     pub x_m: [f64; 2],
 }
 
@@ -113,7 +115,10 @@ impl MergeZone {
         ];
         Some(Self {
             along: along.id(),
-            s_m: [along.project(start_m).s_m, along.project(tail_m).s_m],
+            s_m: [
+                along.project(start_m).s_m,
+                along.project(end_m).s_m + MERGE_ZONE_TAIL_M,
+            ],
             x_m: [start_m[0], tail_m[0]],
         })
     }
@@ -165,5 +170,30 @@ mod tests {
         );
         let g = beyond_divider_m(&lanes, ENDING_LANE_ID, THROUGH_LANE_ID, [100.0, 3.2]).unwrap();
         assert!((g + 0.3).abs() < 1e-12, "{g}");
+    }
+
+    #[test]
+    fn the_merge_zone_bends_with_the_road() {
+        // The merge road bent on a 300 m arc: the through lane's radius is 298.25 m, so the
+        // taper (x from 160 to 260 m on the divider, s from 210 to 310 m along the straight
+        // through lane) lies at s × 298.25/300 along it, and the zone ends 20 m further on.
+        let road = MergeRoad::default();
+        let spec = mergesim_types::lanes::curved_merge_spec(&road, 300.0).unwrap();
+        let lanes = LaneRoad::new(&spec).unwrap();
+        let zone = MergeZone::of(&lanes).unwrap();
+        let k = 298.25 / 300.0;
+        assert!((zone.s_m[0] - 210.0 * k).abs() < 0.01, "{zone:?}");
+        assert!((zone.s_m[1] - (310.0 * k + 20.0)).abs() < 0.01, "{zone:?}");
+        // 1 m left of the divider (x = 100 m on it): the through lane; 1 m right: the ending
+        // lane. On the divider at x = 250 m: in the zone; at x = 100 m: not.
+        let through = lanes.lane(THROUGH_LANE_ID).unwrap();
+        let at = |x_m: f64, d_m: f64| through.point((x_m + 50.0) * k, d_m);
+        assert_eq!(
+            lane_of(&lanes, None, at(100.0, -0.75)).lane,
+            THROUGH_LANE_ID
+        );
+        assert_eq!(lane_of(&lanes, None, at(100.0, -2.75)).lane, ENDING_LANE_ID);
+        assert!(zone.contains(&lanes, at(250.0, -1.75)));
+        assert!(!zone.contains(&lanes, at(100.0, -1.75)));
     }
 }
