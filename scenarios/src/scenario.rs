@@ -3,14 +3,12 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use mergesim_types::lanes::LaneError;
 use planner::{Lane, ParameterSet, PlannerParams};
 use serde::{Deserialize, Serialize};
 use sim::{SimConfig, SimError, VehicleSpec};
 use thiserror::Error;
 
 use crate::builtin;
-use crate::oriented_box::OrientedBox;
 use crate::randomisation::Randomisation;
 use crate::source_location::line_of;
 
@@ -155,7 +153,7 @@ impl Scenario {
             .cloned()
             .unwrap_or_default();
         scenario.apply_parameter_set(origin, Some(text))?;
-        check_one_road(&table, &scenario, origin, text)?;
+        lane_road_checks::check_one_road(&table, &scenario, origin, text)?;
         scenario.check(origin, Some(text))?;
         Ok(scenario)
     }
@@ -421,163 +419,6 @@ impl Scenario {
         Ok(())
     }
 
-    /// The TOML path and the dotted field of a lane error: the lane's entry in
-    /// `[[sim.lane_road.lanes]]` (the second one for a duplicate id) and its field (with the
-    /// vertex index where the error names one), or `[sim.lane_road]` for a generated road.
-    fn lane_error_path(&self, e: &LaneError) -> (Vec<String>, String) {
-        let lanes = self
-            .sim
-            .lane_road
-            .as_ref()
-            .map(|c| &c.lanes[..])
-            .unwrap_or(&[]);
-        let mut path = vec!["sim".to_string(), "lane_road".to_string()];
-        let index = e.lane().and_then(|id| {
-            let mut matches = lanes.iter().enumerate().filter(|(_, l)| l.id == id);
-            let first = matches.next().map(|(i, _)| i);
-            if matches!(e, LaneError::DuplicateId { .. }) {
-                matches.next().map(|(i, _)| i).or(first)
-            } else {
-                first
-            }
-        });
-        let Some(index) = index else {
-            if matches!(e, LaneError::BadTolerance { .. }) {
-                path.extend(["tolerances".to_string(), e.field().to_string()]);
-                return (path, format!("lane_road.tolerances.{}", e.field()));
-            }
-            if lanes.is_empty() {
-                return (path, "lane_road".into());
-            }
-            path.push("lanes".into());
-            return (path, "lane_road.lanes".into());
-        };
-        path.extend([
-            "lanes".to_string(),
-            index.to_string(),
-            e.field().to_string(),
-        ]);
-        let vertex = match e {
-            LaneError::NonFinite { index, .. }
-            | LaneError::SharpTurn { index, .. }
-            | LaneError::NonPositiveWidth { index, .. } => Some(*index),
-            _ => None,
-        };
-        let mut field = format!("lane_road.lanes[{index}].{}", e.field());
-        // A width list of one value stands for every vertex.
-        if let Some(vertex) = vertex {
-            let entries = lanes.get(index).map_or(0, |l| match e.field() {
-                "centreline_m" => l.centreline_m.len(),
-                "width_m" => l.width_m.len(),
-                "left_width_m" => l.left_width_m.len(),
-                "right_width_m" => l.right_width_m.len(),
-                _ => 0,
-            });
-            if vertex < entries {
-                path.push(vertex.to_string());
-                field = format!("{field}[{vertex}]");
-            }
-        }
-        (path, field)
-    }
-
-    /// Spawn geometry on a road of lanes: each vehicle's body, over its randomisation box, lies
-    /// on the drivable area (its four corners do, each at the lane's heading where it stands),
-    /// and no two bodies can overlap (oriented boxes covering each body's randomisation range).
-    /// The road's length against the run's duration is not checked here (a vehicle that reaches
-    /// an open end of the lanes stops the run with an error naming it).
-    fn check_lane_geometry(
-        &self,
-        origin: &str,
-        at: &dyn Fn(Option<Vec<String>>) -> Line,
-    ) -> Result<(), ScenarioError> {
-        let lanes = self.sim.lanes().map_err(|e| ScenarioError::Invalid {
-            origin: origin.to_string(),
-            line: at(Some(vec!["sim".into(), "lane_road".into()])),
-            field: Some("lane_road".into()),
-            message: e.to_string(),
-        })?;
-        let mut boxes: Vec<(String, OrientedBox)> = Vec::with_capacity(self.vehicles.len());
-        for v in &self.vehicles {
-            let field_path = |key: &str| {
-                self.randomise
-                    .vehicle_entry_path(&v.name, key)
-                    .or_else(|| self.nominal_path(&format!("vehicles[{}].{key}", v.name)))
-            };
-            let invalid = |key: &str, message: String| ScenarioError::Invalid {
-                origin: origin.to_string(),
-                line: at(field_path(key)),
-                field: Some(format!("vehicles[{}].{key}", v.name)),
-                message: format!("vehicles[{}].{key}: {message}", v.name),
-            };
-            let params = vehicles::VehicleParams::preset(&v.preset)
-                .map_err(|e| invalid("preset", e.to_string()))?;
-            let Some(lane) = lanes.lane(v.lane.id()) else {
-                return Err(invalid(
-                    "lane",
-                    format!("lane {} is not on the road", v.lane),
-                ));
-            };
-            let b = self.randomise.vehicle_bounds(&v.name);
-            let (half_l, half_w) = (0.5 * params.length_m, 0.5 * params.width_m);
-            let s_range = [v.x_m + b.x_m[0], v.x_m + b.x_m[1]];
-            let d_range = [
-                v.y_offset_m + b.y_offset_m[0],
-                v.y_offset_m + b.y_offset_m[1],
-            ];
-            // Corners at every metre of the s range (and its ends), at both ends of the d range.
-            let steps = ((s_range[1] - s_range[0]).ceil().max(0.0) as usize).min(10_000) + 1;
-            for k in 0..=steps {
-                let s = s_range[0] + (s_range[1] - s_range[0]) * k as f64 / steps as f64;
-                for d in d_range {
-                    let body = OrientedBox::on_lane(lane, s, d, half_l, half_w);
-                    if let Some(corner) =
-                        body.corners().into_iter().find(|c| !lanes.is_drivable(*c))
-                    {
-                        // Off the side with the nominal offset too: the position along the lane is
-                        // the cause.
-                        let centred = OrientedBox::on_lane(lane, s, 0.0, half_l, half_w);
-                        let lateral = centred.corners().iter().all(|c| lanes.is_drivable(*c));
-                        let key = if lateral { "y_offset_m" } else { "x_m" };
-                        return Err(invalid(
-                            key,
-                            format!(
-                                "the body must lie on the road at spawn, including randomisation: \
-                                 at s = {s:.3} m, d = {d:.3} m on lane {} its corner \
-                                 ({:.3}, {:.3}) m is off the road",
-                                v.lane, corner[0], corner[1]
-                            ),
-                        ));
-                    }
-                }
-            }
-            // One box covering the body over the whole range (at the range's middle heading).
-            let s_mid = 0.5 * (s_range[0] + s_range[1]);
-            let d_mid = 0.5 * (d_range[0] + d_range[1]);
-            let swept = OrientedBox::on_lane(
-                lane,
-                s_mid,
-                d_mid,
-                half_l + 0.5 * (s_range[1] - s_range[0]),
-                half_w + 0.5 * (d_range[1] - d_range[0]),
-            );
-            for (other, ob) in &boxes {
-                if swept.overlaps(ob) {
-                    return Err(invalid(
-                        "x_m",
-                        format!(
-                            "x_m = {}: its body can overlap that of vehicle {other} at spawn \
-                             (including randomisation)",
-                            v.x_m
-                        ),
-                    ));
-                }
-            }
-            boxes.push((v.name.clone(), swept));
-        }
-        Ok(())
-    }
-
     /// The TOML path of a nominal field named as the simulator names it (`mu`,
     /// `v2v.latency_s`, `vehicles[ego].x_m`).
     fn nominal_path(&self, field: &str) -> Option<Vec<String>> {
@@ -670,34 +511,6 @@ impl Scenario {
     }
 }
 
-/// `[sim.road]` and a `[sim.lane_road]` that does not bend it (`on_ramp`, `lanes`) cannot both
-/// be given: refused at `[sim.lane_road]`'s line.
-fn check_one_road(
-    table: &toml::Table,
-    scenario: &Scenario,
-    origin: &str,
-    text: &str,
-) -> Result<(), ScenarioError> {
-    let sim = table.get("sim").and_then(|s| s.as_table());
-    let has = |key: &str| sim.is_some_and(|s| s.contains_key(key));
-    let bends = scenario
-        .sim
-        .lane_road
-        .as_ref()
-        .is_some_and(|c| c.is_merge_road());
-    if has("road") && has("lane_road") && !bends {
-        return Err(ScenarioError::Invalid {
-            origin: origin.to_string(),
-            line: Line(line_of(text, &["sim".to_string(), "lane_road".to_string()])),
-            field: Some("lane_road".into()),
-            message: "[sim.road] and [sim.lane_road] both give the road: keep one (only \
-                      lane_road.curved_merge bends [sim.road])"
-                .into(),
-        });
-    }
-    Ok(())
-}
-
 /// The field a simulator error names, if any.
 fn sim_error_field(e: &SimError) -> Option<String> {
     e.field()
@@ -710,5 +523,6 @@ fn split_vehicle_field(field: &str) -> Option<(&str, &str)> {
     Some((name, key))
 }
 
+mod lane_road_checks;
 #[cfg(test)]
 mod tests;

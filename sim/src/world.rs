@@ -17,7 +17,6 @@ use crate::agent::Agent;
 use crate::config::{SimConfig, VehicleSpec};
 use crate::drivers::lane_path;
 use crate::error::SimError;
-use crate::lane_membership::{lane_change, lane_of};
 use crate::metrics::{MetricsSample, VehicleMetrics};
 use crate::observer::{TickObserver, VehicleView};
 use crate::outcome::{PlannerStats, RunOutcome};
@@ -29,6 +28,7 @@ use crate::run_log::RunLog;
 use crate::safety::{BodyState, SafetyMonitor};
 use crate::v2v::V2vBus;
 
+mod lanes;
 mod planning;
 
 /// Options of one run that are not part of the scenario.
@@ -307,7 +307,7 @@ impl World {
                 .collect();
             for (agent, kin) in self.agents.iter().zip(&kins) {
                 check_finite(t_s, &agent.spec.name, kin)?;
-                if let Some(lane) = past_road_end(
+                if let Some(lane) = lanes::past_road_end(
                     &self.lanes,
                     agent.lane,
                     kin,
@@ -439,21 +439,7 @@ impl World {
         bodies: &[BodyState],
     ) -> Result<(), SimError> {
         // Lane changes first (events), then the observers.
-        let mut changes = Vec::new();
-        for (agent, k) in self.agents.iter_mut().zip(kins) {
-            let hit = lane_of(&self.lanes, Some(agent.lane), [k.x_m, k.y_m]);
-            if let Some(direction) = lane_change(&self.lanes, agent.lane, hit.lane) {
-                changes.push(format!(
-                    "t = {t_s:.2} s: {} changed lanes {direction}, from lane {} to lane {}, at \
-                     x = {:.1} m, y = {:.1} m",
-                    agent.spec.name, agent.lane, hit.lane, k.x_m, k.y_m
-                ));
-            }
-            agent.lane = hit.lane;
-        }
-        for text in changes {
-            self.event(text, EventLevel::Info)?;
-        }
+        self.log_lane_changes(t_s, kins)?;
         let samples: Vec<MetricsSample> = kins
             .iter()
             .map(|k| MetricsSample {
@@ -557,27 +543,6 @@ impl World {
             events: self.events,
         })
     }
-}
-
-/// The lane whose open end (the road's end) the vehicle's front has passed, if any: the front
-/// (the centre of gravity + `half_length_m` along the heading) lies beyond the end of the lane
-/// the vehicle is in, and that lane ends without successors, open. On the straight merge road:
-/// the front past `road.end_x_m`.
-fn past_road_end(
-    lanes: &mergesim_types::lanes::LaneRoad,
-    current: mergesim_types::lanes::LaneId,
-    k: &Kinematics,
-    half_length_m: f64,
-) -> Option<mergesim_types::lanes::LaneId> {
-    let hit = lane_of(lanes, Some(current), [k.x_m, k.y_m]);
-    let lane = lanes.lane(hit.lane)?;
-    let open_end = lanes.lane_end(hit.lane).is_some_and(|e| !e.closed);
-    if !open_end {
-        return None;
-    }
-    let (s, c) = k.yaw_rad.sin_cos();
-    let front_m = [k.x_m + half_length_m * c, k.y_m + half_length_m * s];
-    (lane.project(front_m).s_m > lane.length_m()).then_some(hit.lane)
 }
 
 fn percentile(sorted: &[f64], q: f64) -> f64 {
