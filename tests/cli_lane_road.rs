@@ -145,3 +145,78 @@ fn the_new_builtins_load_and_a_run_starts() {
         );
     }
 }
+
+/// The largest distance of `vehicle` from the centreline of the lane it is in (the lanes of
+/// `scenario`'s road), over the run's time series.
+fn max_offset_from_its_lane_m(
+    scenario: &Scenario,
+    rows: &[mergesim::sim::TimeSeriesRow],
+    vehicle: &str,
+) -> f64 {
+    let lanes = scenario.sim.lanes().unwrap();
+    rows.iter()
+        .filter(|r| r.vehicle == vehicle)
+        .map(|r| {
+            let hit = lanes
+                .lanes_at([r.x_m, r.y_m])
+                .into_iter()
+                .next()
+                .unwrap_or_else(|| panic!("{vehicle} off the lanes at t = {}", r.t_s));
+            hit.frame.d_m.abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn the_simulators_drivers_follow_curved_lanes_and_successors() {
+    use mergesim::sim::Driver;
+    // on_ramp: the ego keeps its lane from the ramp (a 150 m arc) into the acceleration lane,
+    // its successor (no lane change); the others follow their main lanes with the IDM.
+    let mut on_ramp = Scenario::load("on_ramp").unwrap();
+    on_ramp.sim.duration_s = 6.0;
+    on_ramp.vehicles[0].driver = Driver::LaneKeeping;
+    for v in &mut on_ramp.vehicles[1..] {
+        v.driver = Driver::Idm;
+    }
+    let outcome = common::simulate(&on_ramp, None, 0, true);
+    assert!(
+        !outcome.events.iter().any(|e| e.contains("changed lanes")),
+        "{:?}",
+        outcome.events
+    );
+    // At 20 m/s the ego leaves the 52.5 m ramp after ≈ 2.4 s: it ends on the acceleration lane.
+    let lanes = on_ramp.sim.lanes().unwrap();
+    let last = outcome
+        .time_series
+        .iter()
+        .rfind(|r| r.vehicle == "ego")
+        .unwrap();
+    let hit = lanes.lanes_at([last.x_m, last.y_m]);
+    assert_eq!(hit.first().map(|h| h.lane.0), Some(3), "{last:?}");
+    for name in ["ego", "obstacle", "overtaker"] {
+        let offset_m = max_offset_from_its_lane_m(&on_ramp, &outcome.time_series, name);
+        assert!(
+            offset_m < 0.3,
+            "{name}: {offset_m} m from its lane's centre"
+        );
+    }
+    // curved_merge: both vehicles keep their lanes on the 300 m curve with the IDM.
+    let mut curved = Scenario::load("curved_merge").unwrap();
+    curved.sim.duration_s = 8.0;
+    for v in &mut curved.vehicles {
+        v.driver = Driver::Idm;
+    }
+    let outcome = common::simulate(&curved, None, 0, true);
+    assert!(
+        !outcome.events.iter().any(|e| e.contains("changed lanes")),
+        "{:?}",
+        outcome.events
+    );
+    for name in ["ego", "obstacle"] {
+        let offset_m = max_offset_from_its_lane_m(&curved, &outcome.time_series, name);
+        assert!(
+            offset_m < 0.3,
+            "{name}: {offset_m} m from its lane's centre"
+        );
+    }
+}
