@@ -102,8 +102,9 @@ pub fn other_limits() -> Vec<(String, String)> {
             "road length".into(),
             format!(
                 "every vehicle's front + `duration_s` × (its highest initial, target or \
-                 prescribed speed, randomisation included) × {} ≤ `end_x_m` (not checked on a \
-                 `[sim.lane_road]`)",
+                 prescribed speed, randomisation included) × {} ≤ `end_x_m`; on a \
+                 `[sim.lane_road]`, ≤ the lanes ahead of it to their open end (on along the \
+                 lane it merges into where its own ends)",
                 1.0 + ROAD_END_SPEED_ALLOWANCE
             ),
         ),

@@ -269,3 +269,31 @@ fn the_new_builtins_load_on_their_roads_of_lanes() {
     assert!(lanes.lane_end(LaneId(3)).unwrap().closed);
     assert_eq!(on_ramp.vehicles[0].lane.id(), LaneId(4));
 }
+
+#[test]
+fn lanes_too_short_for_the_run_are_refused_at_duration_s() {
+    // The ego can drive 20 m/s × 1.1 × 45 s + half its length = 992.3 m; ahead of it: 260 m of
+    // its ending lane, then 440 m of the through lane beside its end.
+    let text = URGENT_AS_LANES.replacen("duration_s = 25.0", "duration_s = 45.0", 1);
+    assert_refused(
+        &text,
+        "duration_s = 45.0",
+        "duration_s",
+        "vehicles[ego], which can drive 992.3 m",
+    );
+    let (_, _, message) = refusal(&text);
+    assert!(message.contains("end after 700.0 m"), "{message}");
+    // on_ramp: from 5 m along the 52.5 m ramp, its successor (the 300 m acceleration lane, which
+    // ends closed) and the right main lane from beside its end (x = 450 m) to x = 650 m.
+    let text = scenarios::builtin::toml_of("on_ramp").unwrap().replacen(
+        "duration_s = 20.0",
+        "duration_s = 30.0",
+        1,
+    );
+    let (_, field, message) = refusal(&text);
+    assert_eq!(field.as_deref(), Some("duration_s"), "{message}");
+    assert!(
+        message.contains("vehicles[ego]") && message.contains("end after 547.5 m"),
+        "{message}"
+    );
+}

@@ -1,7 +1,7 @@
 //! The checks of a scenario whose road is a road of lanes (`[sim.lane_road]`): where a lane
 //! error sits in the file, the spawn geometry in the lanes' frames, and one road per scenario.
 
-use mergesim_types::lanes::LaneError;
+use mergesim_types::lanes::{LaneError, LaneId, LaneRoad};
 
 use super::{Line, Scenario, ScenarioError};
 use crate::oriented_box::OrientedBox;
@@ -71,8 +71,9 @@ impl Scenario {
     /// Spawn geometry on a road of lanes: each vehicle's body, over its randomisation box, lies
     /// on the drivable area (its four corners do, each at the lane's heading where it stands),
     /// and no two bodies can overlap (oriented boxes covering each body's randomisation range).
-    /// The road's length against the run's duration is not checked here (a vehicle that reaches
-    /// an open end of the lanes stops the run with an error naming it).
+    /// The lanes must be long enough for the run: every vehicle driving the whole duration at the
+    /// highest speed it starts at, aims at or is prescribed (+ `ROAD_END_SPEED_ALLOWANCE`) stays
+    /// short of the open end of the lanes ahead of it ([`drivable_ahead_m`]).
     pub(super) fn check_lane_geometry(
         &self,
         origin: &str,
@@ -161,9 +162,76 @@ impl Scenario {
                 }
             }
             boxes.push((v.name.clone(), swept));
+            let prescribed_max_mps = match &v.driver {
+                sim::Driver::Prescribed { speed_profile, .. } => speed_profile
+                    .points
+                    .iter()
+                    .map(|p| p[1])
+                    .fold(0.0, f64::max),
+                _ => 0.0,
+            };
+            let top_speed_mps = (v.speed_mps + b.speed_mps[1])
+                .max(v.target_speed_mps + b.target_speed_mps[1])
+                .max(prescribed_max_mps)
+                * (1.0 + super::ROAD_END_SPEED_ALLOWANCE);
+            let needed_m = half_l + top_speed_mps * self.sim.duration_s;
+            let ahead_m = drivable_ahead_m(&lanes, v.lane.id(), s_range[1]);
+            if needed_m > ahead_m {
+                return Err(ScenarioError::Invalid {
+                    origin: origin.to_string(),
+                    line: at(self.nominal_path("duration_s")),
+                    field: Some("duration_s".into()),
+                    message: format!(
+                        "duration_s = {} s: the lanes are too short for vehicles[{}], which can \
+                         drive {needed_m:.1} m (its front, at {top_speed_mps:.2} m/s = its \
+                         highest initial, target or prescribed speed including randomisation, \
+                         + {:.0} %) while the lanes ahead of it end after {ahead_m:.1} m; \
+                         lengthen the road or shorten the run",
+                        self.sim.duration_s,
+                        v.name,
+                        100.0 * super::ROAD_END_SPEED_ALLOWANCE
+                    ),
+                });
+            }
         }
         Ok(())
     }
+}
+
+/// How far a vehicle at arc length `s_m` of lane `lane` can drive before the road's open end:
+/// along the lane, then its longest successor chain; where a lane ends closed, on along the
+/// neighbour it merges into (left, else right) from beside its end. Each lane is visited once.
+pub(super) fn drivable_ahead_m(lanes: &LaneRoad, lane: LaneId, s_m: f64) -> f64 {
+    fn ahead(lanes: &LaneRoad, lane: LaneId, s_m: f64, visited: &mut Vec<LaneId>) -> f64 {
+        let Some(l) = lanes.lane(lane) else {
+            return 0.0;
+        };
+        if visited.contains(&lane) {
+            return 0.0;
+        }
+        visited.push(lane);
+        let here_m = (l.length_m() - s_m).max(0.0);
+        let next_m = if !l.successors().is_empty() {
+            l.successors()
+                .iter()
+                .map(|n| ahead(lanes, *n, 0.0, visited))
+                .fold(0.0, f64::max)
+        } else if lanes.lane_end(lane).is_some_and(|e| e.closed) {
+            match l.left_neighbour().or(l.right_neighbour()) {
+                Some(nb) => {
+                    let end_m = l.point(l.length_m(), 0.0);
+                    let s_nb = lanes.lane(nb).map_or(0.0, |n| n.project(end_m).s_m);
+                    ahead(lanes, nb, s_nb, visited)
+                }
+                None => 0.0,
+            }
+        } else {
+            0.0
+        };
+        visited.pop();
+        here_m + next_m
+    }
+    ahead(lanes, lane, s_m, &mut Vec::new())
 }
 
 /// `[sim.road]` and a `[sim.lane_road]` that does not bend it (`on_ramp`, `lanes`) cannot both
