@@ -297,3 +297,38 @@ fn lanes_too_short_for_the_run_are_refused_at_duration_s() {
         "{message}"
     );
 }
+
+#[test]
+fn on_the_road_table_lanes_are_named_or_numbered_1_and_2() {
+    let urgent = scenarios::builtin::toml_of("urgent_merge").unwrap();
+    // "upper" is lane 1: the same scenario.
+    let numbered = urgent.replacen("lane = \"upper\"", "lane = 1", 1);
+    let a = Scenario::from_toml(urgent, "a.toml").unwrap();
+    let b = Scenario::from_toml(&numbered, "b.toml").unwrap();
+    assert_eq!(a.vehicles[1].lane.id(), b.vehicles[1].lane.id());
+    assert_eq!(
+        b.vehicles[1].lane.merge_lane(),
+        Some(mergesim_types::Lane::Upper)
+    );
+    // The merge road has no lane 3.
+    let text = urgent.replacen("lane = \"upper\"", "lane = 3", 1);
+    assert_refused(
+        &text,
+        "lane = 3",
+        "vehicles[obstacle].lane",
+        "has lanes \"lower\" (2) and \"upper\" (1)",
+    );
+    // A lane name that is neither.
+    let text = urgent.replacen("lane = \"upper\"", "lane = \"middle\"", 1);
+    let message = Scenario::from_toml(&text, "lanes.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("\"lower\", \"upper\" or a lane id")
+            && message.contains(&format!(
+                "line {}",
+                line_of_text(&text, "lane = \"middle\"")
+            )),
+        "{message}"
+    );
+}
