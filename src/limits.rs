@@ -6,6 +6,7 @@
 //! test keeps the two equal.
 
 use mergesim_types::bounds::{Bound, markdown_rows};
+use mergesim_types::lanes::{CURVED_MERGE_RADIUS_M, ON_RAMP_BOUNDS};
 use mergesim_types::road::{MERGE_SECTION_LENGTH_M, ROAD_BOUNDS};
 use planner::params::{MAX_WAYPOINTS, MIN_WAYPOINTS, PLANNER_BOUNDS};
 use scenarios::scenario::ROAD_END_SPEED_ALLOWANCE;
@@ -23,6 +24,7 @@ pub fn scenario_tables() -> Vec<(&'static str, &'static [Bound])> {
     vec![
         ("sim", SIM_BOUNDS),
         ("sim.road", ROAD_BOUNDS),
+        ("sim.lane_road.on_ramp", ON_RAMP_BOUNDS),
         ("sim.planner", PLANNER_BOUNDS),
         ("sim.tracker", TRACKER_BOUNDS),
         ("sim.safety", SAFETY_BOUNDS),
@@ -55,6 +57,19 @@ pub fn other_limits() -> Vec<(String, String)> {
             format!("{merge_min_m} to {merge_max_m} m"),
         ),
         (
+            "`[sim.lane_road]` `curved_merge.radius_m`".into(),
+            format!(
+                "absolute radius {} to {} m, and at least the road's length / 6",
+                CURVED_MERGE_RADIUS_M[0], CURVED_MERGE_RADIUS_M[1]
+            ),
+        ),
+        (
+            "`[sim.lane_road]` lanes".into(),
+            "consistent (ids, links, widths > 0, ≥ 2 distinct vertices, turns ≤ 90°); \
+             `on_ramp.main_length_m` past the acceleration lane's end"
+                .into(),
+        ),
+        (
             "`[sim.idm]` decelerations".into(),
             "`comfortable_decel_mps2` ≤ `max_decel_mps2`".into(),
         ),
@@ -71,20 +86,25 @@ pub fn other_limits() -> Vec<(String, String)> {
         ),
         (
             "`[[vehicles]]` `x_m`".into(),
-            "on the road: in [`start_x_m`, `end_x_m`]".into(),
+            "on the road: in [`start_x_m`, `end_x_m`]; on a `[sim.lane_road]`, the arc length \
+             along its lane, in [0, the lane's length]"
+                .into(),
         ),
         (
             "`[[vehicles]]` body at spawn".into(),
             "on the road surface (between the edges, within its length), not overlapping \
              another body, a lower-lane front before `merge_end_x_m` — over the whole \
-             randomisation box"
+             randomisation box; on a `[sim.lane_road]`, its corners on the lanes and no \
+             overlap (oriented boxes)"
                 .into(),
         ),
         (
             "road length".into(),
             format!(
                 "every vehicle's front + `duration_s` × (its highest initial, target or \
-                 prescribed speed, randomisation included) × {} ≤ `end_x_m`",
+                 prescribed speed, randomisation included) × {} ≤ `end_x_m`; on a \
+                 `[sim.lane_road]`, ≤ the lanes ahead of it to their open end (on along the \
+                 lane it merges into where its own ends)",
                 1.0 + ROAD_END_SPEED_ALLOWANCE
             ),
         ),

@@ -42,7 +42,8 @@ fn registry() -> BehaviourRegistry {
             Arc::new(|input: &FactoryInput<'_>| {
                 Ok(Box::new(FixedSpeed {
                     speed_mps: 12.0,
-                    lane: input.spec.lane,
+                    // The merge road's lanes by name ("lower" / "upper" or ids 2 / 1).
+                    lane: input.spec.lane.merge_lane().unwrap(),
                 }) as Box<dyn Behaviour>)
             }),
         )
@@ -80,7 +81,7 @@ fn a_registered_planner_drives_its_vehicle_among_pf_iso_traffic() {
             .summary
             .events
             .iter()
-            .any(|e| e.contains("ego crossed"))
+            .any(|e| e.contains("ego changed lanes left"))
     );
     // The same name through the override applies it to every planner-driven vehicle (for the
     // first 8 s: the ego, held in its ending lane, would reach the taper).

@@ -119,6 +119,16 @@ impl EnvCore {
         vehicle: Option<&str>,
     ) -> PyResult<Self> {
         let scenario = source::load(scenario, params_json)?;
+        // The environment's observations, commands and rendering are those of the straight
+        // merge road (x along it, y across it); a road of lanes is refused, not misread.
+        if !scenario.sim.is_straight_merge_road() {
+            return Err(BindingError::Input(format!(
+                "scenario {}: MergeEnv runs on the straight [sim.road] merge road only; this \
+                 scenario's road is a [sim.lane_road]",
+                scenario.name
+            ))
+            .into());
+        }
         let names: Vec<&str> = scenario.vehicles.iter().map(|v| v.name.as_str()).collect();
         let agent = match vehicle {
             Some(name) => names.iter().position(|n| *n == name).ok_or_else(|| {
@@ -183,7 +193,11 @@ impl EnvCore {
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner) = Command {
             target_speed_mps: agent_spec.target_speed_mps,
-            target_y_m: instance.sim.road.lane_center_y_m(agent_spec.lane) + agent_spec.y_offset_m,
+            target_y_m: instance
+                .sim
+                .road
+                .lane_center_y_m(agent_spec.lane.merge_lane().unwrap_or(sim::Lane::Lower))
+                + agent_spec.y_offset_m,
         };
         *self
             .contacts

@@ -126,3 +126,11 @@ def test_bad_reward_weights_and_step_before_reset() -> None:
     env = mergesim.MergeEnv(params=SHORT)
     with pytest.raises(mergesim.ScenarioError, match="before reset"):
         env.step(HOLD_LANE)
+
+
+def test_a_road_of_lanes_is_refused_not_misread() -> None:
+    # The environment's observations and commands are the straight merge road's.
+    for name in ("curved_merge", "on_ramp"):
+        refused = "straight \\[sim.road\\] merge road only"
+        with pytest.raises(mergesim.ScenarioError, match=refused):
+            mergesim.MergeEnv(scenario=name)

@@ -19,6 +19,8 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "platoon_merge_50",
         include_str!("../builtin/platoon_merge_50.toml"),
     ),
+    ("curved_merge", include_str!("../builtin/curved_merge.toml")),
+    ("on_ramp", include_str!("../builtin/on_ramp.toml")),
 ];
 
 /// Names of the built-in scenarios.

@@ -9,6 +9,7 @@
 
 pub mod builtin;
 pub mod distribution;
+pub mod oriented_box;
 pub mod platoon;
 pub mod randomisation;
 pub mod scenario;

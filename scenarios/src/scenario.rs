@@ -153,6 +153,7 @@ impl Scenario {
             .cloned()
             .unwrap_or_default();
         scenario.apply_parameter_set(origin, Some(text))?;
+        lane_road_checks::check_one_road(&table, &scenario, origin, text)?;
         scenario.check(origin, Some(text))?;
         Ok(scenario)
     }
@@ -204,6 +205,15 @@ impl Scenario {
         let at =
             |entry: Option<Vec<String>>| Line(text.zip(entry).and_then(|(t, p)| line_of(t, &p)));
         let sim_error = |e: SimError, prefix: &str, entry: Option<Vec<String>>| {
+            if let SimError::Road(lane_error) = &e {
+                let (path, field) = self.lane_error_path(lane_error);
+                return ScenarioError::Invalid {
+                    origin: origin.to_string(),
+                    line: at(Some(path)),
+                    message: format!("{prefix}{field}: {lane_error}"),
+                    field: Some(field),
+                };
+            }
             let field = sim_error_field(&e);
             let nominal = field.as_deref().and_then(|f| self.nominal_path(f));
             ScenarioError::Invalid {
@@ -254,6 +264,9 @@ impl Scenario {
         origin: &str,
         at: &dyn Fn(Option<Vec<String>>) -> Line,
     ) -> Result<(), ScenarioError> {
+        if !self.sim.is_straight_merge_road() {
+            return self.check_lane_geometry(origin, at);
+        }
         let road = &self.sim.road;
         // Axis-aligned hull of each vehicle's body over the randomisation box (bodies are boxes
         // centred on the centre of gravity, spawned with zero yaw).
@@ -268,7 +281,9 @@ impl Scenario {
                 })?;
             let b = self.randomise.vehicle_bounds(&v.name);
             let (half_l, half_w) = (0.5 * params.length_m, 0.5 * params.width_m);
-            let y_c = road.lane_center_y_m(v.lane) + v.y_offset_m;
+            // `validate_vehicles` refused lanes the merge road does not have.
+            let lane = v.lane.merge_lane().unwrap_or(Lane::Lower);
+            let y_c = road.lane_center_y_m(lane) + v.y_offset_m;
             let x = [v.x_m + b.x_m[0] - half_l, v.x_m + b.x_m[1] + half_l];
             let y = [
                 y_c + b.y_offset_m[0] - half_w,
@@ -279,7 +294,7 @@ impl Scenario {
                     .vehicle_entry_path(&v.name, "x_m")
                     .or_else(|| self.nominal_path(&format!("vehicles[{}].x_m", v.name)))
             };
-            if v.lane == Lane::Lower && x[1] > road.merge_end_x_m {
+            if lane == Lane::Lower && x[1] > road.merge_end_x_m {
                 return Err(ScenarioError::Invalid {
                     origin: origin.to_string(),
                     line: at(x_entry()),
@@ -444,6 +459,15 @@ impl Scenario {
         let base = toml::Table::try_from(self.params.planner_params())
             .map_err(|e| error(e.to_string()))?;
         if let Some(sim) = table.get_mut("sim").and_then(|v| v.as_table_mut()) {
+            // A road of lanes that does not bend `[sim.road]` stands alone (check_one_road).
+            if self
+                .sim
+                .lane_road
+                .as_ref()
+                .is_some_and(|c| !c.is_merge_road())
+            {
+                sim.remove("road");
+            }
             let differing: toml::Table = match sim.get("planner").and_then(|p| p.as_table()) {
                 Some(planner) => planner
                     .iter()
@@ -499,5 +523,6 @@ fn split_vehicle_field(field: &str) -> Option<(&str, &str)> {
     Some((name, key))
 }
 
+mod lane_road_checks;
 #[cfg(test)]
 mod tests;

@@ -1,8 +1,9 @@
 //! A vehicle of the world with its decision making: the Rapier vehicle, its tracker, its
 //! behaviour (planner, human-driver model, prescribed-speed driver or a user's), the path it
-//! is tracking, and whether it has crossed the lane divider yet.
+//! is tracking, and the lane it is in (lane changes are events).
 
-use mergesim_types::{Behaviour, Lane, PathPoint, VehicleId, VehicleShape};
+use mergesim_types::lanes::{LaneId, LaneRoad};
+use mergesim_types::{Behaviour, PathPoint, VehicleId, VehicleShape};
 use vehicles::{Tracker, Vehicle, VehicleParams};
 
 use crate::config::{Driver, SimConfig, VehicleSpec};
@@ -26,8 +27,8 @@ pub struct Agent {
     pub tracker: Tracker,
     /// The path being tracked.
     pub path: Vec<PathPoint>,
-    /// Whether a vehicle that started in the ending lane has crossed the divider yet.
-    pub merged: bool,
+    /// The lane it is in (`crate::lane_membership`), last checked at a logged instant.
+    pub lane: LaneId,
     /// The degraded mode of its last decision (events on changes).
     pub degraded_mode: Option<String>,
 }
@@ -52,21 +53,24 @@ pub fn behaviour_of(
             profile: speed_profile.clone(),
         }),
         Driver::LaneKeeping => Box::new(LaneKeeping {
-            lane: spec.lane,
-            y_offset_m: spec.y_offset_m,
+            lane: spec.lane.id(),
+            d_offset_m: spec.y_offset_m,
         }),
         Driver::Idm => Box::new(IdmDriver {
             params: config.idm.clone(),
-            lane: spec.lane,
-            y_offset_m: spec.y_offset_m,
+            lane: spec.lane.id(),
+            d_offset_m: spec.y_offset_m,
         }),
     })
 }
 
 impl Agent {
-    /// Spawns vehicle `index` of the scenario on the road of `physics`.
+    /// Spawns vehicle `index` of the scenario on the road of `physics`: on the straight
+    /// `[sim.road]` merge road at (x_m, lane centre + y_offset_m) heading +x; on a road of lanes
+    /// at (s = x_m, d = y_offset_m) of its start lane, heading along the lane.
     pub fn spawn(
         config: &SimConfig,
+        lanes: &LaneRoad,
         physics: &mut vehicles::PhysicsWorld,
         index: usize,
         spec: &VehicleSpec,
@@ -74,8 +78,24 @@ impl Agent {
         planner_override: Option<&str>,
     ) -> Result<Self, SimError> {
         let params = VehicleParams::preset(&spec.preset)?;
-        let y_m = config.road.lane_center_y_m(spec.lane) + spec.y_offset_m;
-        let vehicle = Vehicle::spawn(physics, &params, spec.x_m, y_m, 0.0, spec.speed_mps)?;
+        let (x_m, y_m, yaw_rad) = match (config.is_straight_merge_road(), spec.lane.merge_lane()) {
+            (true, Some(lane)) => (
+                spec.x_m,
+                config.road.lane_center_y_m(lane) + spec.y_offset_m,
+                0.0,
+            ),
+            _ => {
+                let lane = lanes
+                    .lane(spec.lane.id())
+                    .ok_or_else(|| SimError::InvalidField {
+                        field: format!("vehicles[{}].lane", spec.name),
+                        message: format!("lane {} does not exist on the road", spec.lane),
+                    })?;
+                let [x, y] = lane.point(spec.x_m, spec.y_offset_m);
+                (x, y, lane.heading_rad(spec.x_m))
+            }
+        };
+        let vehicle = Vehicle::spawn(physics, &params, x_m, y_m, yaw_rad, spec.speed_mps)?;
         let shape = vehicle.shape(VehicleShape::default().max_brake_decel_mps2);
         let behaviour = behaviour_of(config, spec, registry, planner_override)?;
         let tracker = Tracker::new(config.tracker.clone(), &params);
@@ -87,7 +107,7 @@ impl Agent {
             behaviour,
             tracker,
             path: Vec::new(),
-            merged: spec.lane == Lane::Upper,
+            lane: spec.lane.id(),
             degraded_mode: None,
         })
     }

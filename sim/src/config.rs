@@ -1,6 +1,6 @@
 //! What a simulation is made of: the shared settings and the vehicles to spawn.
 
-use planner::{Lane, MergeRoad, PlannerParams, SpeedProfile};
+use planner::{MergeRoad, PlannerParams, SpeedProfile};
 use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
 
@@ -8,6 +8,7 @@ use mergesim_types::{Bound, bounds};
 
 use crate::error::SimError;
 use crate::idm::IdmParams;
+use crate::road_config::{LaneRoadConfig, StartLane, build_lane_road};
 use crate::safety::SafetyParams;
 use crate::v2v::V2vParams;
 
@@ -15,8 +16,12 @@ use crate::v2v::V2vParams;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SimConfig {
-    /// Road geometry (shared by the planner's road field and the road collider).
+    /// The parametric merge road (`[sim.road]`, the paper's straight road): the road of lanes
+    /// unless `lane_road` gives another one (`curved_merge` bends this one).
     pub road: MergeRoad,
+    /// A road of lanes instead of `road` (`[sim.lane_road]`; `crate::road_config`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lane_road: Option<LaneRoadConfig>,
     /// Tire–road friction coefficient μ.
     pub mu: f64,
     /// Physics step (s).
@@ -50,6 +55,7 @@ impl Default for SimConfig {
     fn default() -> Self {
         Self {
             road: MergeRoad::default(),
+            lane_road: None,
             mu: 0.8,
             dt_s: 0.002,
             duration_s: 25.0,
@@ -108,10 +114,23 @@ pub const MAX_PLANNING_CYCLES: f64 = 2e6;
 pub const MAX_PAIR_CHECKS: f64 = 1e9;
 
 impl SimConfig {
+    /// The run's road of lanes: `lane_road` if given, else `road` (`crate::road_config`).
+    /// Refuses inconsistent lane data ([`SimError::Road`] names the lane and the field).
+    pub fn lanes(&self) -> Result<mergesim_types::lanes::LaneRoad, SimError> {
+        build_lane_road(&self.road, self.lane_road.as_ref())
+    }
+
+    /// True if the road is the `[sim.road]` merge road, straight (no `lane_road`): vehicle
+    /// positions are then world x (`x_m`) and offsets from the lane centre (`y_offset_m`).
+    pub fn is_straight_merge_road(&self) -> bool {
+        self.lane_road.is_none()
+    }
+
     /// Checks every field against its bounds and the periods against the physics step; the
     /// error names the field and its value.
     pub fn validate(&self) -> Result<(), SimError> {
         self.road.validate()?;
+        self.lanes()?;
         bounds::check_all(
             "",
             SIM_BOUNDS,
@@ -208,11 +227,14 @@ pub struct VehicleSpec {
     pub name: String,
     /// Vehicle preset (`bmw_320i`, `ford_escort`, `vw_vanagon`).
     pub preset: String,
-    /// Starting lane.
-    pub lane: Lane,
-    /// Initial longitudinal position of the centre of gravity (m).
+    /// Starting lane: `"lower"` / `"upper"` (the merge road's lanes 2 and 1) or a lane id.
+    pub lane: StartLane,
+    /// Initial longitudinal position of the centre of gravity (m): on the straight `[sim.road]`
+    /// merge road its x; on a road of lanes (`[sim.lane_road]`) its arc length s along the start
+    /// lane's centreline, from the lane's first vertex.
     pub x_m: f64,
-    /// Lateral offset from the lane centre (m).
+    /// Lateral offset from the lane centre (m, positive to the left; on a road of lanes the
+    /// lane-frame offset d).
     #[serde(default)]
     pub y_offset_m: f64,
     /// Initial speed (m/s).
@@ -278,6 +300,12 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
             ));
         }
     }
+    // The road of lanes, when it is not the straight merge road (positions in its frame).
+    let lanes = if config.is_straight_merge_road() {
+        None
+    } else {
+        Some(config.lanes()?)
+    };
     for (i, spec) in specs.iter().enumerate() {
         if specs[..i].iter().any(|other| other.name == spec.name) {
             return Err(SimError::InvalidField {
@@ -311,6 +339,45 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
                 ("target_speed_mps", spec.target_speed_mps),
             ],
         )?;
+        if let Some(lanes) = lanes.as_ref() {
+            let Some(lane) = lanes.lane(spec.lane.id()) else {
+                return Err(SimError::InvalidField {
+                    field: field("lane"),
+                    message: format!(
+                        "lane {} does not exist on the road (its lanes: {})",
+                        spec.lane,
+                        lanes
+                            .lanes()
+                            .iter()
+                            .map(|l| l.id().to_string())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                });
+            };
+            if !(spec.x_m.is_finite() && spec.x_m >= 0.0 && spec.x_m <= lane.length_m()) {
+                return Err(SimError::invalid(
+                    field("x_m"),
+                    spec.x_m,
+                    format!(
+                        "on a road of lanes x_m is the arc length along lane {}: it must lie \
+                         in [0, {:.3}] m",
+                        spec.lane,
+                        lane.length_m()
+                    ),
+                ));
+            }
+            continue;
+        }
+        if spec.lane.merge_lane().is_none() {
+            return Err(SimError::InvalidField {
+                field: field("lane"),
+                message: format!(
+                    "lane {}: the [sim.road] merge road has lanes \"lower\" (2) and \"upper\" (1)",
+                    spec.lane
+                ),
+            });
+        }
         if !(spec.x_m.is_finite()
             && spec.x_m >= config.road.start_x_m
             && spec.x_m <= config.road.end_x_m)

@@ -66,7 +66,7 @@ pub enum SimError {
     /// A vehicle reached the end of the road before the run ended (the scenario loader refuses
     /// roads too short for the run; a `World` built directly can still meet this).
     #[error(
-        "vehicle {vehicle} reached the end of the road (road.end_x_m = {end_x_m} m) at t = {t_s} s; \
+        "vehicle {vehicle} reached the end of the road (the end of lane {lane}) at t = {t_s} s; \
          lengthen the road or shorten duration_s"
     )]
     RoadEnd {
@@ -74,8 +74,8 @@ pub enum SimError {
         vehicle: String,
         /// When its front passed the end (s).
         t_s: f64,
-        /// Where the road ends (m).
-        end_x_m: f64,
+        /// The lane whose open end it passed (on the merge road, lane 1 ends at road.end_x_m).
+        lane: mergesim_types::lanes::LaneId,
     },
     /// The run was interrupted (a signal) before its end.
     #[error("interrupted at t = {t_s} s")]

@@ -110,7 +110,9 @@ pub struct Leader {
     pub speed_mps: f64,
 }
 
-/// What [`find_leader`] needs to know of a vehicle (world frame, road along +X).
+/// What [`find_leader`] needs to know of a vehicle, in a lane's frame: `x_m` the arc length s
+/// along the lane, `y_m` the offset d across it (on the straight merge road, x and y up to a
+/// constant).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoadUser {
     /// Position of the centre (m).

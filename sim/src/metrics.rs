@@ -350,10 +350,14 @@ impl VehicleMetrics {
         }
     }
 
-    /// The same metrics also computing the paper's figures on `road` against
+    /// The same metrics also computing the paper's figures on the road `lanes` against
     /// `target_speed_mps` ([`crate::paper_metrics`]).
-    pub fn with_paper_metrics(mut self, road: &planner::MergeRoad, target_speed_mps: f64) -> Self {
-        self.paper = Some(PaperMetrics::new(road, target_speed_mps));
+    pub fn with_paper_metrics(
+        mut self,
+        lanes: std::sync::Arc<mergesim_types::lanes::LaneRoad>,
+        target_speed_mps: f64,
+    ) -> Self {
+        self.paper = Some(PaperMetrics::new(lanes, target_speed_mps));
         self
     }
 

@@ -2,27 +2,34 @@
 //! slowing, how much it winds inside the merge zone against outside it, how far it strays from
 //! its lane centre, and where and when it crosses the lane divider.
 //!
-//! Fed the same samples as [`crate::metrics::VehicleMetrics`] (one per logged instant):
+//! Fed the same samples as [`crate::metrics::VehicleMetrics`] (one per logged instant), and read
+//! through the road of lanes ([`crate::lane_membership`]), so they mean the same on any road:
 //! - **slowing onset**: the first sample more than `slowing_threshold_mps` below the vehicle's
 //!   target speed (tracker noise stays within a few cm/s);
 //! - **yaw-rate RMS inside / outside the merge zone**: √(∫ r² dt / T) over the intervals whose
-//!   mean x lies inside (outside) `merge_zone_x_m`, r linear between samples (exact integral);
+//!   midpoint lies inside (outside) the merge zone, r linear between samples (exact integral);
 //!   the paper sees the winding between 167 and 272 m, i.e. in the merge section (160–260 m
-//!   here) and just after it, so the default zone is the merge section and the 20 m after its
-//!   end (one second at 20 m/s, where a path that left the taper settles);
-//! - **largest lateral offset from its lane centre**: the centre of the lane the vehicle is in
-//!   at each sample (above the divider: the through lane's; below it: halfway between the
-//!   tapering lower edge and the divider);
-//! - **divider crossing**: the first time the centre of gravity crosses Y_lane, with t and x
-//!   interpolated linearly between the samples, and how many times it crossed.
+//!   here) and just after it, so the zone is the ending lane's taper and the 20 m after its end
+//!   (one second at 20 m/s, where a path that left the taper settles), measured along the lane
+//!   it merges into ([`MergeZone`]); on a road without an ending lane there is none (every
+//!   interval is outside, and `merge_zone_x_m` is `[0, 0]`);
+//! - **largest lateral offset from its lane centre**: the distance, in the lane's frame, from the
+//!   middle between the two bounds of the lane the vehicle is in (lane membership with
+//!   hysteresis): on the merge road, above the divider the through lane's centre, below it
+//!   halfway between the tapering lower edge and the divider;
+//! - **divider crossing**: the first lane change (the lane membership changing to a lane that is
+//!   not a successor), with t and x interpolated linearly between the samples on the crossed
+//!   bound, and how many lane changes it made, in either direction.
 
-use planner::MergeRoad;
+use std::sync::Arc;
+
+use mergesim_types::lanes::{LaneId, LaneRoad};
 use serde::{Deserialize, Serialize};
 
+use crate::lane_membership::{MergeZone, beyond_divider_m, lane_change, lane_of};
 use crate::metrics::MetricsSample;
 
-/// Length of road after the merge section that still counts as the merge zone (m).
-pub const MERGE_ZONE_TAIL_M: f64 = 20.0;
+pub use crate::lane_membership::MERGE_ZONE_TAIL_M;
 
 /// A speed drop below the target smaller than this is tracker noise, not slowing (m/s).
 pub const SLOWING_THRESHOLD_MPS: f64 = 0.1;
@@ -43,7 +50,7 @@ pub struct PaperMetricsSummary {
     pub target_speed_mps: f64,
     /// First time more than 0.1 m/s below the target speed (s); null if never.
     pub slowing_onset_s: Option<f64>,
-    /// The merge zone `[x_start_m, x_end_m]`.
+    /// The world x of the merge zone's ends `[x_start_m, x_end_m]` (module doc).
     pub merge_zone_x_m: [f64; 2],
     /// Yaw-rate RMS over the time spent inside the merge zone (rad/s); null if never inside.
     pub merge_zone_rms_yaw_rate_radps: Option<f64>,
@@ -51,21 +58,22 @@ pub struct PaperMetricsSummary {
     pub outside_merge_zone_rms_yaw_rate_radps: Option<f64>,
     /// Time spent inside the merge zone (s).
     pub merge_zone_time_s: f64,
-    /// Largest |y − lane centre| of the lane it is in (m).
+    /// Largest distance from the middle of the lane it is in (m, in the lane's frame).
     pub max_abs_lane_offset_m: f64,
     /// First crossing of the lane divider; null if never.
     pub divider_crossing: Option<DividerCrossing>,
-    /// Number of divider crossings.
+    /// Number of lane changes (divider crossings, either way).
     pub divider_crossings: u32,
 }
 
 /// Running paper metrics of one vehicle.
 #[derive(Clone, Debug)]
 pub struct PaperMetrics {
-    road: MergeRoad,
+    lanes: Arc<LaneRoad>,
+    zone: Option<MergeZone>,
     target_speed_mps: f64,
-    merge_zone_x_m: [f64; 2],
     last: Option<MetricsSample>,
+    lane: Option<LaneId>,
     slowing_onset_s: Option<f64>,
     zone_integral_sq: f64,
     zone_time_s: f64,
@@ -77,14 +85,15 @@ pub struct PaperMetrics {
 }
 
 impl PaperMetrics {
-    /// Empty metrics of a vehicle with `target_speed_mps` on `road`; the merge zone is the
-    /// merge section and [`MERGE_ZONE_TAIL_M`] after it.
-    pub fn new(road: &MergeRoad, target_speed_mps: f64) -> Self {
+    /// Empty metrics of a vehicle with `target_speed_mps` on `lanes`; the merge zone is the
+    /// ending lane's taper and [`MERGE_ZONE_TAIL_M`] after its end (module doc).
+    pub fn new(lanes: Arc<LaneRoad>, target_speed_mps: f64) -> Self {
         Self {
-            merge_zone_x_m: [road.merge_start_x_m, road.merge_end_x_m + MERGE_ZONE_TAIL_M],
-            road: road.clone(),
+            zone: MergeZone::of(&lanes),
+            lanes,
             target_speed_mps,
             last: None,
+            lane: None,
             slowing_onset_s: None,
             zone_integral_sq: 0.0,
             zone_time_s: 0.0,
@@ -96,16 +105,6 @@ impl PaperMetrics {
         }
     }
 
-    /// Lateral centre of the lane a vehicle at (x, y) is in (m).
-    fn lane_centre_y_m(&self, x_m: f64, y_m: f64) -> f64 {
-        let y_lane = self.road.y_lane_m();
-        if y_m >= y_lane || !self.road.has_divider(x_m) {
-            self.road.lane_center_y_m(planner::Lane::Upper)
-        } else {
-            0.5 * (self.road.lower_edge_y_m(x_m) + y_lane)
-        }
-    }
-
     /// Adds the next sample (the caller checks finiteness and increasing time).
     pub fn push(&mut self, s: &MetricsSample) {
         if self.slowing_onset_s.is_none()
@@ -113,26 +112,41 @@ impl PaperMetrics {
         {
             self.slowing_onset_s = Some(s.t_s);
         }
-        let offset = (s.y_m - self.lane_centre_y_m(s.x_m, s.y_m)).abs();
-        self.max_abs_lane_offset_m = self.max_abs_lane_offset_m.max(offset);
+        let hit = lane_of(&self.lanes, self.lane, [s.x_m, s.y_m]);
+        if let Some(lane) = self.lanes.lane(hit.lane) {
+            let mid_d_m = 0.5 * (lane.left_d_m(hit.frame.s_m) + lane.right_d_m(hit.frame.s_m));
+            let offset = (hit.frame.d_m - mid_d_m).abs();
+            self.max_abs_lane_offset_m = self.max_abs_lane_offset_m.max(offset);
+        }
         if let Some(p) = self.last {
             let dt_s = s.t_s - p.t_s;
             let (r0, r1) = (p.yaw_rate_radps, s.yaw_rate_radps);
             let integral_sq = dt_s * (r0 * r0 + r0 * r1 + r1 * r1) / 3.0;
-            let mid_x_m = 0.5 * (p.x_m + s.x_m);
-            let [x0, x1] = self.merge_zone_x_m;
-            if mid_x_m >= x0 && mid_x_m <= x1 {
+            let mid_m = [0.5 * (p.x_m + s.x_m), 0.5 * (p.y_m + s.y_m)];
+            let inside = self
+                .zone
+                .as_ref()
+                .is_some_and(|z| z.contains(&self.lanes, mid_m));
+            if inside {
                 self.zone_integral_sq += integral_sq;
                 self.zone_time_s += dt_s;
             } else {
                 self.outside_integral_sq += integral_sq;
                 self.outside_time_s += dt_s;
             }
-            let y_lane = self.road.y_lane_m();
-            if (p.y_m < y_lane) != (s.y_m < y_lane) {
+            if let Some(from) = self.lane
+                && lane_change(&self.lanes, from, hit.lane).is_some()
+            {
                 self.divider_crossings += 1;
                 if self.divider_crossing.is_none() {
-                    let f = ((y_lane - p.y_m) / (s.y_m - p.y_m)).clamp(0.0, 1.0);
+                    // Linear between the samples, on the bound between the two lanes.
+                    let f = match (
+                        beyond_divider_m(&self.lanes, from, hit.lane, [p.x_m, p.y_m]),
+                        beyond_divider_m(&self.lanes, from, hit.lane, [s.x_m, s.y_m]),
+                    ) {
+                        (Some(g0), Some(g1)) if g1 != g0 => (g0 / (g0 - g1)).clamp(0.0, 1.0),
+                        _ => 1.0,
+                    };
                     self.divider_crossing = Some(DividerCrossing {
                         t_s: p.t_s + f * dt_s,
                         x_m: p.x_m + f * (s.x_m - p.x_m),
@@ -140,6 +154,7 @@ impl PaperMetrics {
                 }
             }
         }
+        self.lane = Some(hit.lane);
         self.last = Some(*s);
     }
 
@@ -149,7 +164,7 @@ impl PaperMetrics {
         PaperMetricsSummary {
             target_speed_mps: self.target_speed_mps,
             slowing_onset_s: self.slowing_onset_s,
-            merge_zone_x_m: self.merge_zone_x_m,
+            merge_zone_x_m: self.zone.as_ref().map_or([0.0, 0.0], |z| z.x_m),
             merge_zone_rms_yaw_rate_radps: rms(self.zone_integral_sq, self.zone_time_s),
             outside_merge_zone_rms_yaw_rate_radps: rms(
                 self.outside_integral_sq,
@@ -166,6 +181,7 @@ impl PaperMetrics {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mergesim_types::MergeRoad;
 
     fn sample(t_s: f64, x_m: f64, y_m: f64, r: f64, v: f64) -> MetricsSample {
         MetricsSample {
@@ -183,8 +199,8 @@ mod tests {
 
     #[test]
     fn onset_zone_rms_offset_and_crossing() {
-        let road = MergeRoad::default();
-        let mut m = PaperMetrics::new(&road, 15.0);
+        let lanes = Arc::new(MergeRoad::default().lane_road().unwrap());
+        let mut m = PaperMetrics::new(lanes, 15.0);
         // 0–10 s at x = 150 → 250 m, constant yaw rate 0.02 inside the zone (from 160 m), 0
         // outside; slowing below 14.9 m/s from t = 4 s; crossing the divider at t = 5.5 s.
         for k in 0..=100 {
@@ -214,8 +230,8 @@ mod tests {
 
     #[test]
     fn never_slowing_nor_crossing_gives_nulls() {
-        let road = MergeRoad::default();
-        let mut m = PaperMetrics::new(&road, 15.0);
+        let lanes = Arc::new(MergeRoad::default().lane_road().unwrap());
+        let mut m = PaperMetrics::new(lanes, 15.0);
         for k in 0..10 {
             m.push(&sample(k as f64, 10.0 * k as f64, 5.25, 0.0, 15.0));
         }

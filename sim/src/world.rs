@@ -28,6 +28,7 @@ use crate::run_log::RunLog;
 use crate::safety::{BodyState, SafetyMonitor};
 use crate::v2v::V2vBus;
 
+mod lanes;
 mod planning;
 
 /// Options of one run that are not part of the scenario.
@@ -46,7 +47,8 @@ pub struct RunOptions {
 /// The simulation.
 pub struct World {
     config: SimConfig,
-    /// The road as lanes, built once from `config.road` (shared with the observations).
+    /// The road as lanes, built once from `config.lane_road` or else `config.road` (shared with
+    /// the observations and the metrics).
     lanes: std::sync::Arc<mergesim_types::lanes::LaneRoad>,
     physics: PhysicsWorld,
     agents: Vec<Agent>,
@@ -68,9 +70,16 @@ pub struct World {
     steps_per_safety: u64,
     reported_collisions: usize,
     reported_edge_contacts: usize,
+    /// False on a road of lanes: the parry road-edge test still reads the straight `[sim.road]`
+    /// edges, which are not this road's, so its contacts are dropped until the edge test is
+    /// built from the lanes.
+    straight_edges: bool,
     profiler: Profiler,
     planning_pool: Option<std::sync::Arc<rayon::ThreadPool>>,
 }
+
+/// How far the flat surface under a road of lanes reaches beyond its lanes' centrelines (m).
+const FLAT_GROUND_MARGIN_M: f64 = 200.0;
 
 fn steps_for(period_s: f64, dt_s: f64) -> u64 {
     ((period_s / dt_s).round() as u64).max(1)
@@ -104,13 +113,27 @@ impl World {
     ) -> Result<Self, SimError> {
         config.validate()?;
         crate::config::validate_vehicles(&config, specs)?;
-        let lanes = std::sync::Arc::new(config.road.lane_road()?);
+        let lanes = std::sync::Arc::new(config.lanes()?);
         let mut physics = PhysicsWorld::new(config.dt_s)?;
-        physics.add_merge_road(&config.road);
+        if config.is_straight_merge_road() {
+            physics.add_merge_road(&config.road);
+        } else {
+            // A road of lanes: a flat surface under all of it (the lanes' collider and barriers
+            // come with the lane-geometry road collider).
+            let reach_m = lanes.lanes().iter().fold(0.0_f64, |r, l| {
+                let [lo, hi] = l.centreline().bounding_box_m();
+                r.max(lo[0].abs())
+                    .max(lo[1].abs())
+                    .max(hi[0].abs())
+                    .max(hi[1].abs())
+            });
+            physics.add_flat_ground(reach_m + FLAT_GROUND_MARGIN_M);
+        }
         let mut agents = Vec::with_capacity(specs.len());
         for (index, spec) in specs.iter().enumerate() {
             agents.push(Agent::spawn(
                 &config,
+                &lanes,
                 &mut physics,
                 index,
                 spec,
@@ -127,7 +150,7 @@ impl World {
             .iter()
             .map(|a| {
                 VehicleMetrics::new(a.spec.name.clone())
-                    .with_paper_metrics(&config.road, a.spec.target_speed_mps)
+                    .with_paper_metrics(lanes.clone(), a.spec.target_speed_mps)
             })
             .collect();
         let recording = RecordingObserver::new(recorder, &config.road)?;
@@ -136,6 +159,7 @@ impl World {
             steps_per_log: steps_for(config.log_period_s, config.dt_s),
             steps_per_field: steps_for(config.field_log_period_s, config.dt_s),
             steps_per_safety: steps_for(config.safety_period_s, config.dt_s),
+            straight_edges: config.is_straight_merge_road(),
             config,
             lanes,
             physics,
@@ -245,10 +269,10 @@ impl World {
             if agent.path.is_empty() {
                 let v = agent.spec.target_speed_mps;
                 agent.path = lane_path(
-                    &self.config.road,
-                    agent.spec.lane,
+                    &self.lanes,
+                    agent.spec.lane.id(),
                     agent.spec.y_offset_m,
-                    kin.x_m,
+                    [kin.x_m, kin.y_m],
                     t_s,
                     |_| v,
                 );
@@ -283,12 +307,16 @@ impl World {
                 .collect();
             for (agent, kin) in self.agents.iter().zip(&kins) {
                 check_finite(t_s, &agent.spec.name, kin)?;
-                let front_m = kin.x_m + 0.5 * agent.vehicle.params().length_m;
-                if front_m > self.config.road.end_x_m {
+                if let Some(lane) = lanes::past_road_end(
+                    &self.lanes,
+                    agent.lane,
+                    kin,
+                    0.5 * agent.vehicle.params().length_m,
+                ) {
                     return Err(SimError::RoadEnd {
                         vehicle: agent.spec.name.clone(),
                         t_s,
-                        end_x_m: self.config.road.end_x_m,
+                        lane,
                     });
                 }
             }
@@ -380,6 +408,9 @@ impl World {
             })?;
             self.reported_collisions += 1;
         }
+        if !self.straight_edges {
+            self.reported_edge_contacts = self.safety.edge_contact_events().len();
+        }
         while self.reported_edge_contacts < self.safety.edge_contact_events().len() {
             let event = self.safety.edge_contact_events()[self.reported_edge_contacts].clone();
             let name = names.get(event.id as usize).cloned().unwrap_or_default();
@@ -408,20 +439,7 @@ impl World {
         bodies: &[BodyState],
     ) -> Result<(), SimError> {
         // Lane changes first (events), then the observers.
-        let y_lane_m = self.config.road.y_lane_m();
-        let mut crossings = Vec::new();
-        for (agent, k) in self.agents.iter_mut().zip(kins) {
-            if !agent.merged && k.y_m > y_lane_m {
-                agent.merged = true;
-                crossings.push(format!(
-                    "t = {t_s:.2} s: {} crossed the lane divider at x = {:.1} m",
-                    agent.spec.name, k.x_m
-                ));
-            }
-        }
-        for text in crossings {
-            self.event(text, EventLevel::Info)?;
-        }
+        self.log_lane_changes(t_s, kins)?;
         let samples: Vec<MetricsSample> = kins
             .iter()
             .map(|k| MetricsSample {
@@ -481,7 +499,10 @@ impl World {
     }
 
     fn finish(mut self) -> Result<RunOutcome, SimError> {
-        let safety = self.safety.summary();
+        let mut safety = self.safety.summary();
+        if !self.straight_edges {
+            safety.edge_contacts.clear();
+        }
         if safety.near_miss {
             let text = format!(
                 "near miss: min gap {} m, min TTC {}",

@@ -21,9 +21,11 @@ const NOT_ENDPOINTS: [&str; 3] = [
 /// The per-vehicle figures an endpoint may name, sorted: every numeric field of a vehicle's
 /// summary and of its `paper_metrics` (read off a summary, so new figures join by themselves).
 pub fn vehicle_figures() -> Vec<String> {
-    let road = planner::MergeRoad::default();
+    let Ok(lanes) = planner::MergeRoad::default().lane_road() else {
+        return Vec::new();
+    };
     let template = VehicleMetrics::new("v")
-        .with_paper_metrics(&road, 20.0)
+        .with_paper_metrics(std::sync::Arc::new(lanes), 20.0)
         .summary();
     let mut names = Vec::new();
     let Ok(Value::Object(map)) = serde_json::to_value(&template) else {
