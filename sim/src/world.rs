@@ -106,7 +106,9 @@ impl World {
         crate::config::validate_vehicles(&config, specs)?;
         let lanes = std::sync::Arc::new(config.road.lane_road()?);
         let mut physics = PhysicsWorld::new(config.dt_s)?;
-        physics.add_merge_road(&config.road);
+        // Built from the lanes, around a local origin near the road (module doc of
+        // `vehicles::PhysicsWorld`); the vehicles report the road's own coordinates.
+        physics.add_lane_road(&lanes);
         let mut agents = Vec::with_capacity(specs.len());
         for (index, spec) in specs.iter().enumerate() {
             agents.push(Agent::spawn(
@@ -122,7 +124,7 @@ impl World {
             config.v2v.clone(),
             crate::rng::SplitMix64::derive(options.seed, 1),
         )?;
-        let safety = SafetyMonitor::new(config.safety.clone(), &config.road)?;
+        let safety = SafetyMonitor::new(config.safety.clone(), lanes.clone())?;
         let metrics = agents
             .iter()
             .map(|a| {
