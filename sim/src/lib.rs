@@ -18,6 +18,7 @@ pub mod recording;
 pub mod recording_observer;
 pub mod registry;
 pub mod rng;
+pub mod road_drawing;
 pub mod run_log;
 pub mod safety;
 pub mod spatial;

@@ -132,7 +132,7 @@ impl World {
                     .with_paper_metrics(&config.road, a.spec.target_speed_mps)
             })
             .collect();
-        let recording = RecordingObserver::new(recorder, &config.road)?;
+        let recording = RecordingObserver::new(recorder, &lanes)?;
         Ok(Self {
             steps_per_plan: steps_for(config.planner_period_s, config.dt_s),
             steps_per_log: steps_for(config.log_period_s, config.dt_s),
