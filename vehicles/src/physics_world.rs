@@ -29,8 +29,8 @@ pub const FALLBACK_GROUND_HALF_EXTENT_M: f64 = 1000.0;
 /// Rapier's `f32` resolves 0.5 mm at 6 km but 61 µm below 1 km. Every position handed to
 /// Rapier is therefore taken relative to a *local origin* (m, in the road's coordinates):
 /// (0, 0) until [`add_lane_road`](Self::add_lane_road) sets it from the road
-/// ([`local_origin_for`]: the road bounds' centre snapped to 1024 m, so a road near the origin
-/// is not moved). The vehicles convert at their boundary ([`crate::Vehicle::spawn`],
+/// ([`local_origin_for`]: (0, 0) for a road centred within 2048 m of the origin, else the road
+/// bounds' centre snapped to 1024 m). The vehicles convert at their boundary ([`crate::Vehicle::spawn`],
 /// [`crate::Vehicle::kinematics`], [`crate::Vehicle::wheel_telemetry`]): everything they take
 /// and give is in the road's own coordinates. Only what is read straight from Rapier
 /// ([`rapier`](Self::rapier), [`bodies`](Self::bodies), [`colliders`](Self::colliders), scene

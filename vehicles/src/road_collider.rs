@@ -21,9 +21,14 @@ use serde::{Deserialize, Serialize};
 
 use crate::collision_groups;
 
-/// Grid the local origin snaps to (m): a power of two, so the shift is exact and a road within
-/// ±512 m of the world origin (the built-in straight merge road) is not moved at all.
+/// Grid the local origin snaps to (m): a power of two, so the shift is exact.
 pub const LOCAL_ORIGIN_GRID_M: f64 = 1024.0;
+
+/// A road whose bounds' centre lies within this of the world origin in both coordinates is
+/// not moved (m): every built-in road (the 3050 m platoon road's centre is at x = 1475 m)
+/// keeps its Rapier coordinates, and so its results, bit for bit. Beyond it (a map kilometres
+/// away) the f32 resolution (0.49 mm at 4 to 8 km) is worth the shift.
+pub const LOCAL_ORIGIN_KEEP_M: f64 = 2048.0;
 
 /// How far beside an edge piece the drivable area is probed to tell the road's side (m): more
 /// than the lanes' sliver tolerance ([`mergesim_types::lanes::SLIVER_M`], 5 mm).
@@ -121,21 +126,20 @@ pub fn road_bounds_m(lanes: &LaneRoad) -> [[f64; 2]; 2] {
     [lo, hi]
 }
 
-/// The local origin a road is built around (m): the centre of [`road_bounds_m`] rounded to the
-/// nearest multiple of [`LOCAL_ORIGIN_GRID_M`] in each coordinate. A road centred within 512 m
-/// of the world origin keeps (0, 0); a road 5.9 km away is shifted so that its Rapier
-/// coordinates stay within its own extent + 512 m of the local origin.
+/// The local origin a road is built around (m): (0, 0) if the centre of [`road_bounds_m`] lies
+/// within [`LOCAL_ORIGIN_KEEP_M`] of the world origin in both coordinates, else that centre
+/// rounded to the nearest multiple of [`LOCAL_ORIGIN_GRID_M`] in each coordinate: a road
+/// 5.9 km away is shifted so that its Rapier coordinates stay within half its extent + 512 m
+/// of the local origin.
 pub fn local_origin_for(lanes: &LaneRoad) -> [f64; 2] {
     let [lo, hi] = road_bounds_m(lanes);
-    let snap = |a: f64, b: f64| {
-        let c = 0.5 * (a + b);
-        if c.is_finite() {
-            (c / LOCAL_ORIGIN_GRID_M).round() * LOCAL_ORIGIN_GRID_M
-        } else {
-            0.0
-        }
-    };
-    [snap(lo[0], hi[0]), snap(lo[1], hi[1])]
+    let centre = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+    if !centre.iter().all(|c| c.is_finite())
+        || centre.iter().all(|c| c.abs() <= LOCAL_ORIGIN_KEEP_M)
+    {
+        return [0.0, 0.0];
+    }
+    centre.map(|c| (c / LOCAL_ORIGIN_GRID_M).round() * LOCAL_ORIGIN_GRID_M)
 }
 
 /// One wall whose inner face lies on `a → b`, extending away from the road.
@@ -364,6 +368,35 @@ mod tests {
                 "s {s}: {r_low:?} vs {expected}"
             );
         }
+    }
+
+    /// The platoon's 3050 m road (bounds' centre at x = 1475 m) is not moved (its results stay
+    /// bit for bit); the same road 3 km further is, by whole grid steps.
+    #[test]
+    fn a_long_road_near_the_origin_is_not_moved() {
+        let road = MergeRoad {
+            merge_start_x_m: 1300.0,
+            merge_end_x_m: 1400.0,
+            start_x_m: -50.0,
+            end_x_m: 3000.0,
+            ..MergeRoad::default()
+        };
+        let lanes = road.lane_road().unwrap_or_else(|e| panic!("{e}"));
+        let mut world = PhysicsWorld::new(0.002).unwrap();
+        world.add_lane_road(&lanes);
+        assert_eq!(world.local_origin_m(), [0.0, 0.0]);
+        let further = MergeRoad {
+            merge_start_x_m: 4300.0,
+            merge_end_x_m: 4400.0,
+            start_x_m: 2950.0,
+            end_x_m: 6000.0,
+            ..MergeRoad::default()
+        };
+        let lanes = further.lane_road().unwrap_or_else(|e| panic!("{e}"));
+        let mut world = PhysicsWorld::new(0.002).unwrap();
+        world.add_lane_road(&lanes);
+        // Centre x = 4475 m: 4.37 grid steps.
+        assert_eq!(world.local_origin_m(), [4096.0, 0.0]);
     }
 
     #[test]
