@@ -4,8 +4,8 @@
 //! Each frame shows, as [`GifParams::view`] says, either the whole road with every vehicle
 //! (scaled to the picture's width, as the recording's whole-road view; [`GifView::Road`]) or a
 //! window that follows one vehicle (the recording's follow view: [`GifParams::behind_m`] behind
-//! it, [`GifParams::ahead_m`] ahead, the road's whole width, centred on it and turned so that
-//! its lane runs to the right, along a curve too; [`GifView::Follow`]). Any road of lanes is
+//! it, [`GifParams::ahead_m`] ahead, the road's whole width centred on the road's middle, turned
+//! so that its lane runs to the right, along a curve too; [`GifView::Follow`]). Any road of lanes is
 //! drawn ([`sim::road_drawing::RoadDrawing`]): the drivable area's outer edges solid, the
 //! dividers dashed, closed lane ends in red, the merge sections (the tapering stretch of each
 //! lane that ends) shaded, the lanes' ids on request ([`GifParams::lane_ids`]); every vehicle as its oriented

@@ -84,7 +84,8 @@ impl RoadDrawing {
                 .copied()
                 .filter(|&s| lane.width_m(s) >= widest - 1e-6)
                 .fold(f64::NAN, f64::max);
-            if !(start < end.s_m) {
+            // (NaN: no vertex at the widest, nothing to shade.)
+            if start.is_nan() || start >= end.s_m {
                 continue;
             }
             let mut ss: Vec<f64> = vec![start];
@@ -203,18 +204,67 @@ impl RoadDrawing {
     }
 }
 
+/// The lateral offset (m, d in lane `id`'s frame, left positive) of the middle of the road
+/// across that lane: halfway between the lane's leftmost left bound plus the widest widths of
+/// its chain of left neighbours, and its rightmost right bound minus those of its right
+/// neighbours. Constant along the lane and the same line from each of the lanes side by side
+/// (on the merge road: the divider, from either lane, also beyond the lane's end), so a view
+/// centred on it does not jump at lane ends or lane changes. 0 for an unknown lane.
+pub fn road_middle_offset_m(lanes: &LaneRoad, id: mergesim_types::lanes::LaneId) -> f64 {
+    let Some(lane) = lanes.lane(id) else {
+        return 0.0;
+    };
+    let at_vertices = |f: &dyn Fn(f64) -> f64| -> Vec<f64> {
+        lane.centreline()
+            .vertex_s_m()
+            .iter()
+            .map(|&s| f(s))
+            .collect()
+    };
+    let left = at_vertices(&|s| lane.left_d_m(s))
+        .into_iter()
+        .fold(f64::NEG_INFINITY, f64::max);
+    let right = at_vertices(&|s| lane.right_d_m(s))
+        .into_iter()
+        .fold(f64::INFINITY, f64::min);
+    let chain = |side: Side| {
+        let mut seen = vec![id];
+        let mut total = 0.0;
+        let mut next = lane.neighbour(side);
+        while let Some(n) = next {
+            if seen.contains(&n) {
+                break;
+            }
+            seen.push(n);
+            total += widest_width_m(lanes, n);
+            next = lanes.lane(n).and_then(|l| l.neighbour(side));
+        }
+        total
+    };
+    let top = left + chain(Side::Left);
+    let bottom = right - chain(Side::Right);
+    if top.is_finite() && bottom.is_finite() {
+        0.5 * (top + bottom)
+    } else {
+        0.0
+    }
+}
+
+/// The widest width of lane `id` over its vertices (m; 0 for an unknown lane).
+fn widest_width_m(lanes: &LaneRoad, id: mergesim_types::lanes::LaneId) -> f64 {
+    lanes.lane(id).map_or(0.0, |l| {
+        l.centreline()
+            .vertex_s_m()
+            .iter()
+            .map(|&s| l.width_m(s))
+            .fold(0.0_f64, f64::max)
+    })
+}
+
 /// The largest width of the road across (m): over every lane, the sum of the widest widths of
 /// the lane and of its chains of left and right neighbours. (The merge road: 7 m.)
 pub fn road_width_m(lanes: &LaneRoad) -> f64 {
-    let widest = |id| {
-        lanes.lane(id).map_or(0.0, |l| {
-            l.centreline()
-                .vertex_s_m()
-                .iter()
-                .map(|&s| l.width_m(s))
-                .fold(0.0_f64, f64::max)
-        })
-    };
+    let widest = |id| widest_width_m(lanes, id);
     let mut best: f64 = 0.0;
     for lane in lanes.lanes() {
         let mut total = widest(lane.id());
@@ -253,7 +303,7 @@ pub fn dashes(polyline: &[[f64; 2]], dash_m: f64, gap_m: f64) -> Vec<Vec<[f64; 2
     for w in polyline.windows(2) {
         let (a, b) = (w[0], w[1]);
         let len = dist(a, b);
-        if !(len > 0.0) {
+        if len.is_nan() || len <= 0.0 {
             continue;
         }
         let s_b = s_a + len;
@@ -320,6 +370,20 @@ mod tests {
         assert!((lo - road.merge_start_x_m).abs() < 1e-9, "{lo}");
         assert!((hi - road.merge_end_x_m).abs() < 1e-9, "{hi}");
         assert!((road_width_m(&lanes) - 2.0 * road.lane_width_m).abs() < 1e-9);
+        // The road's middle (the divider, y = 3.5 m) from either lane.
+        use mergesim_types::lanes::{ENDING_LANE_ID, THROUGH_LANE_ID};
+        let through = road.lane_center_y_m(mergesim_types::Lane::Upper);
+        let ending = road.lane_center_y_m(mergesim_types::Lane::Lower);
+        let from_through = through + road_middle_offset_m(&lanes, THROUGH_LANE_ID);
+        let from_ending = ending + road_middle_offset_m(&lanes, ENDING_LANE_ID);
+        assert!(
+            (from_through - road.y_lane_m()).abs() < 1e-9,
+            "{from_through}"
+        );
+        assert!(
+            (from_ending - road.y_lane_m()).abs() < 1e-9,
+            "{from_ending}"
+        );
         assert_eq!(drawing.lane_labels.len(), 2);
     }
 }

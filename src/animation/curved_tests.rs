@@ -54,9 +54,10 @@ fn the_road_view_draws_the_curve() {
     assert!(share > 0.99, "{share}");
 }
 
-/// The follow view on the curve: centred on the vehicle, turned to its lane's heading (the
-/// lane runs to the right at the vehicle), and the edges drawn where the curve puts them (they
-/// bend away from the picture's horizontal by u²/(2R) over the window).
+/// The follow view on the curve: at the vehicle's station, centred on the road's middle (the
+/// divider, 1.75 m right of the through lane's centre), turned to its lane's heading (the lane
+/// runs to the right at the vehicle), and the edges drawn where the curve puts them (they bend
+/// away from the picture's horizontal by u²/(2R) over the window).
 #[test]
 fn the_follow_view_turns_along_the_curve() {
     ensure_font().unwrap_or_else(|e| panic!("{e}"));
@@ -70,12 +71,22 @@ fn the_follow_view_turns_along_the_curve() {
     let params = GifParams::default();
     let geometry = FrameGeometry::follow(&lanes, &params, [x, y]);
     assert!((geometry.rotation_rad - lane.heading_rad(s)).abs() < 1e-9);
-    // The vehicle at the window's centre line, `behind_m` from the left.
+    // The vehicle `behind_m` from the left, 1.75 m (the half lane) above the middle.
     let (px, py) = geometry.to_px(x, y);
     let k = geometry.px_per_m_x;
     assert_eq!(px, (params.behind_m * k).round() as i32);
     let middle = f64::from(geometry.top_px) + 0.5 * f64::from(geometry.size_px.1 - geometry.top_px);
-    assert!((f64::from(py) - middle).abs() <= 1.0, "{py} vs {middle}");
+    assert!(
+        (f64::from(py) - (middle - 1.75 * k)).abs() <= 1.0,
+        "{py} vs {middle}"
+    );
+    // The divider at the vehicle's station: on the middle line.
+    let [dx, dy] = lane.point(s, -1.75);
+    let (_, py_divider) = geometry.to_px(dx, dy);
+    assert!(
+        (f64::from(py_divider) - middle).abs() <= 1.0,
+        "{py_divider} vs {middle}"
+    );
     // Along the lane, 2 m either side of the vehicle, the lane runs horizontally.
     let (_, y_behind) = geometry.to_px(lane.point(s - 2.0, 0.0)[0], lane.point(s - 2.0, 0.0)[1]);
     let (_, y_ahead) = geometry.to_px(lane.point(s + 2.0, 0.0)[0], lane.point(s + 2.0, 0.0)[1]);

@@ -6,7 +6,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use sim::TimeSeriesRow;
 use sim::recording::vehicle_color;
-use sim::road_drawing::{RoadDrawing, road_width_m};
+use sim::road_drawing::{RoadDrawing, road_middle_offset_m, road_width_m};
 use sim::safety::CollisionEvent;
 
 use super::{GifParams, GifVehicle, GifView};
@@ -32,8 +32,9 @@ const ROAD_VIEW_MAX_STRETCHED_HEIGHT: f64 = 1.0;
 
 /// How road coordinates map to a frame's pixels: a point p is turned into the view's axes,
 /// (u, v) = R(−rotation) (p − origin), then u goes to the right and v up. The road view has no
-/// rotation and its origin at (0, 0) (u, v = X, Y); the follow view is centred on the followed
-/// vehicle and turned so that its lane runs to the right, along a curve too.
+/// rotation and its origin at (0, 0) (u, v = X, Y); the follow view's origin is the followed
+/// vehicle's station on the middle of the road, turned so that its lane runs to the right,
+/// along a curve too.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameGeometry {
     /// The view's origin in road coordinates (m).
@@ -56,24 +57,30 @@ pub struct FrameGeometry {
 }
 
 impl FrameGeometry {
-    /// The follow view of a vehicle at `centre_m`: [`GifParams::behind_m`] behind it to
-    /// [`GifParams::ahead_m`] ahead along its lane's heading there (the nearest lane's), the
-    /// road's whole width ([`sim::road_drawing::road_width_m`]) with [`GifParams::margin_m`]
-    /// beside it, centred on the vehicle, one scale.
-    pub fn follow(lanes: &LaneRoad, params: &GifParams, centre_m: [f64; 2]) -> Self {
+    /// The follow view of a vehicle at `vehicle_m`: [`GifParams::behind_m`] behind it to
+    /// [`GifParams::ahead_m`] ahead along its lane (the nearest lane) and turned to the lane's
+    /// heading there; across, the road's whole width ([`sim::road_drawing::road_width_m`]) with
+    /// [`GifParams::margin_m`] beside it, centred on the road's middle
+    /// ([`sim::road_drawing::road_middle_offset_m`]: on the straight merge road the divider, as
+    /// before); one scale.
+    pub fn follow(lanes: &LaneRoad, params: &GifParams, vehicle_m: [f64; 2]) -> Self {
         let px_per_m = f64::from(params.width_px) / (params.behind_m + params.ahead_m);
         let half_height_m = 0.5 * road_width_m(lanes) + params.margin_m;
         let road_px = (2.0 * half_height_m * px_per_m).ceil().clamp(16.0, 4000.0);
-        let rotation_rad = if centre_m.iter().all(|c| c.is_finite()) {
-            let hit = lanes.nearest_lane(centre_m);
-            lanes
-                .lane(hit.lane)
-                .map_or(0.0, |l| l.heading_rad(hit.frame.s_m))
+        let (origin_m, rotation_rad) = if vehicle_m.iter().all(|c| c.is_finite()) {
+            let hit = lanes.nearest_lane(vehicle_m);
+            lanes.lane(hit.lane).map_or((vehicle_m, 0.0), |l| {
+                let s = hit.frame.s_m;
+                (
+                    l.point(s, road_middle_offset_m(lanes, hit.lane)),
+                    l.heading_rad(s),
+                )
+            })
         } else {
-            0.0
+            (vehicle_m, 0.0)
         };
         Self {
-            origin_m: centre_m,
+            origin_m,
             rotation_rad,
             x0_m: -params.behind_m,
             y_top_m: half_height_m,
