@@ -1,15 +1,17 @@
 //! The recording draws any road of lanes: the curved merge road's edges lie on its outer
-//! edges, its divider is dashed, and the lanes' ids are written on request.
+//! edges, its divider is dashed, the lanes' ids are written on request, and the follow frame
+//! turns with the followed vehicle's lane.
 
 use std::collections::BTreeMap;
 use std::io::BufReader;
 
 use mergesim_types::MergeRoad;
-use mergesim_types::lanes::{LaneRoad, curved_merge_spec};
+use mergesim_types::lanes::{LaneRoad, THROUGH_LANE_ID, curved_merge_spec};
 use re_log_encoding::DecoderApp;
 use rerun::StoreKind;
 use rerun::log::{Chunk, LogMsg};
 use sim::recording::{Recorder, RecorderParams};
+use sim::safety::BodyState;
 
 /// Every line strip logged under each entity, decoded from the file.
 fn strips(path: &std::path::Path) -> BTreeMap<String, Vec<Vec<[f32; 2]>>> {
@@ -37,6 +39,30 @@ fn strips(path: &std::path::Path) -> BTreeMap<String, Vec<Vec<[f32; 2]>>> {
     out
 }
 
+/// The rotations logged for `world/follow`, (x, y, z, w).
+fn follow_quaternions(path: &std::path::Path) -> Vec<[f32; 4]> {
+    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{e}"));
+    let mut out = Vec::new();
+    for msg in DecoderApp::decode_lazy(BufReader::new(file)) {
+        let msg = msg.unwrap_or_else(|e| panic!("{e}"));
+        let LogMsg::ArrowMsg(store_id, arrow_msg) = &msg else {
+            continue;
+        };
+        if store_id.kind() == StoreKind::Blueprint {
+            continue;
+        }
+        let chunk = Chunk::from_arrow_msg(arrow_msg).unwrap_or_else(|e| panic!("{e}"));
+        if chunk.entity_path().to_string() != "/world/follow" {
+            continue;
+        }
+        let id = rerun::Transform3D::descriptor_quaternion().component;
+        for row in chunk.iter_component::<rerun::components::RotationQuat>(id) {
+            out.extend(row.iter().map(|q| q.0.0));
+        }
+    }
+    out
+}
+
 #[test]
 fn a_curved_road_is_recorded_along_its_curve() {
     let spec = curved_merge_spec(&MergeRoad::default(), 300.0).unwrap_or_else(|e| panic!("{e}"));
@@ -51,7 +77,36 @@ fn a_curved_road_is_recorded_along_its_curve() {
     let mut rec = Recorder::new_file_with_params(&path, "mergesim_test", params)
         .unwrap_or_else(|e| panic!("{e}"));
     rec.log_road(&lanes).unwrap_or_else(|e| panic!("{e}"));
+    // The ego on the through lane at s = 400 m: the follow frame turns to the lane's heading.
+    let lane = lanes
+        .lane(THROUGH_LANE_ID)
+        .unwrap_or_else(|| panic!("no through lane"));
+    let [x, y] = lane.point(400.0, 0.0);
+    let heading = lane.heading_rad(400.0);
+    rec.set_time(0.0).unwrap_or_else(|e| panic!("{e}"));
+    let ego = BodyState {
+        id: 0,
+        x_m: x,
+        y_m: y,
+        yaw_rad: heading,
+        vx_mps: 20.0 * heading.cos(),
+        vy_mps: 20.0 * heading.sin(),
+        yaw_rate_radps: 0.0,
+        length_m: 4.5,
+        width_m: 1.8,
+        height_m: 1.4,
+    };
+    rec.log_vehicles(&[ego], &["ego".to_string()])
+        .unwrap_or_else(|e| panic!("{e}"));
     rec.finish().unwrap_or_else(|e| panic!("{e}"));
+    let quaternions = follow_quaternions(&path);
+    assert_eq!(quaternions.len(), 1);
+    let q = quaternions[0];
+    let (s, c) = (0.5 * heading).sin_cos();
+    let expected = [c as f32, s as f32, 0.0, 0.0];
+    for k in 0..4 {
+        assert!((q[k] - expected[k]).abs() < 1e-6, "{q:?} vs {expected:?}");
+    }
     let strips = strips(&path);
     for entity in [
         "/world/road/edges",

@@ -81,9 +81,10 @@ impl Recorder {
     /// [`RecorderParams::lane_ids`](super::RecorderParams::lane_ids), each lane's id; and the
     /// static frame of the whole-road view.
     pub fn log_road(&mut self, lanes: &LaneRoad) -> Result<(), RecordingError> {
-        let Some(active) = &self.active else {
+        let Some(active) = &mut self.active else {
             return Ok(());
         };
+        active.lanes = Some(lanes.clone());
         let drawing = crate::road_drawing::RoadDrawing::new(lanes);
         let to_2d = |p: &[f64; 2]| [p[0] as f32, p[1] as f32];
         let strips = |lines: &[Vec<[f64; 2]>]| -> Vec<Vec<[f32; 2]>> {
@@ -254,11 +255,30 @@ impl Recorder {
             .position(|n| *n == self.params.follow)
             .and_then(|i| bodies.get(i))
         {
+            // Turned to the heading of the vehicle's lane (the nearest lane of the logged road),
+            // so that the follow view turns along a curve: R = R_z(θ) · R_x(π) = (x, y, z, w)
+            // (cos θ/2, sin θ/2, 0, 0); θ = 0 on a straight road along X (the plain Y flip).
+            let heading_rad = active
+                .lanes
+                .as_ref()
+                .filter(|_| body.x_m.is_finite() && body.y_m.is_finite())
+                .map_or(0.0, |lanes| {
+                    let hit = lanes.nearest_lane([body.x_m, body.y_m]);
+                    lanes
+                        .lane(hit.lane)
+                        .map_or(0.0, |l| l.heading_rad(hit.frame.s_m))
+                });
+            let rotation = if heading_rad == 0.0 {
+                y_up_quaternion()
+            } else {
+                let (s, c) = (0.5 * heading_rad).sin_cos();
+                rerun::datatypes::Quaternion::from_xyzw([c as f32, s as f32, 0.0, 0.0])
+            };
             active.stream.log(
                 "world/follow",
                 &Transform3D::from_translation_rotation(
                     [body.x_m as f32, body.y_m as f32, 0.0],
-                    y_up_quaternion(),
+                    rotation,
                 ),
             )?;
         }

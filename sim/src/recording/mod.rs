@@ -38,8 +38,10 @@
 //! # Following a vehicle
 //! Rerun 0.36 has no follow camera and a view's visual bounds are a blueprint value, not a
 //! temporal one. The recording therefore logs, at every logged instant, the transform of
-//! `world/follow` (translation = the followed vehicle's position, rotation = 180° about X, which
-//! turns Y up on screen). The "Follow" view has `world/follow` as its origin, so Rerun draws
+//! `world/follow` (translation = the followed vehicle's position, rotation = the heading θ of
+//! its lane (the nearest lane of the road given to `log_road`) about Z, then 180° about X, which
+//! turns Y up on screen; θ = 0 on the straight merge road), so the follow view turns along a
+//! curve. The "Follow" view has `world/follow` as its origin, so Rerun draws
 //! everything under `world` in that frame: the followed vehicle stays at (0, 0) and the visual
 //! bounds ([`RecorderParams::follow_window_m`]) form a fixed window around it. The "Whole road"
 //! view has the static frame `world/overview` as its origin.
