@@ -4,8 +4,11 @@
 //! Each frame shows, as [`GifParams::view`] says, either the whole road with every vehicle
 //! (scaled to the picture's width, as the recording's whole-road view; [`GifView::Road`]) or a
 //! window that follows one vehicle (the recording's follow view: [`GifParams::behind_m`] behind
-//! it, [`GifParams::ahead_m`] ahead, the road's whole width; [`GifView::Follow`]). Drawn: the
-//! road edges, the lane divider, the merge section (orange), every vehicle as its oriented
+//! it, [`GifParams::ahead_m`] ahead, the road's whole width centred on the road's middle, turned
+//! so that its lane runs to the right, along a curve too; [`GifView::Follow`]). Any road of lanes is
+//! drawn ([`sim::road_drawing::RoadDrawing`]): the drivable area's outer edges solid, the
+//! dividers dashed, closed lane ends in red, the merge sections (the tapering stretch of each
+//! lane that ends) shaded, the lanes' ids on request ([`GifParams::lane_ids`]); every vehicle as its oriented
 //! footprint in its colour ([`sim::recording::vehicle_color`], the same RGB as in the recording
 //! and the figures: the GIF's palette keeps these colours exact) with its name, and a header
 //! with the time, the followed vehicle's speed and the last collision. Vehicles in a collision
@@ -19,10 +22,12 @@ pub use frame::FrameGeometry;
 
 use std::path::{Path, PathBuf};
 
+use mergesim_types::lanes::LaneRoad;
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 use sim::TimeSeriesRow;
 use sim::recording::vehicle_color;
+use sim::road_drawing::RoadDrawing;
 use sim::safety::CollisionEvent;
 use thiserror::Error;
 
@@ -79,6 +84,8 @@ pub struct GifParams {
     pub margin_m: f64,
     /// The whole road or the window around the followed vehicle (`behind_m`, `ahead_m`).
     pub view: GifView,
+    /// Write each lane's id on the road (`merge_sim run --lane-ids`).
+    pub lane_ids: bool,
 }
 
 impl Default for GifParams {
@@ -90,6 +97,7 @@ impl Default for GifParams {
             ahead_m: 50.0,
             margin_m: 2.0,
             view: GifView::Follow,
+            lane_ids: false,
         }
     }
 }
@@ -178,10 +186,10 @@ impl GifParams {
         Ok(())
     }
 
-    /// The picture size (pixels) of the follow view of `road` (the road view's depends on the
+    /// The picture size (pixels) of the follow view of `lanes` (the road view's depends on the
     /// run: [`FrameGeometry::whole_road`]).
-    pub fn size_px(&self, road: &sim::MergeRoad) -> (u32, u32) {
-        FrameGeometry::follow(road, self, 0.0).size_px
+    pub fn size_px(&self, lanes: &LaneRoad) -> (u32, u32) {
+        FrameGeometry::follow(lanes, self, [0.0, 0.0]).size_px
     }
 }
 
@@ -205,13 +213,13 @@ fn frame_instants<'a>(all: &[&'a [TimeSeriesRow]], fps: f64) -> Vec<&'a [TimeSer
 }
 
 /// Writes the animation of a run to `path` (through a temporary file, renamed when complete):
-/// the road `road`, the vehicles `vehicles`, their time series `rows` (as `RunOutcome`'s, in
+/// the road `lanes`, the vehicles `vehicles`, their time series `rows` (as `RunOutcome`'s, in
 /// time order), the collisions `collisions`, following the vehicle named `follow`.
 /// `title` heads every frame. `progress` gets the fraction of frames written.
 #[allow(clippy::too_many_arguments)]
 pub fn write_gif(
     path: &Path,
-    road: &sim::MergeRoad,
+    lanes: &LaneRoad,
     vehicles: &[GifVehicle],
     rows: &[TimeSeriesRow],
     collisions: &[CollisionEvent],
@@ -240,13 +248,15 @@ pub fn write_gif(
         message: e.to_string(),
     };
     ensure_font().map_err(|e| draw_err(&e))?;
-    let whole_road = FrameGeometry::whole_road(road, params, rows);
+    let whole_road = FrameGeometry::whole_road(lanes, params, rows);
     let size = match params.view {
         GifView::Road => whole_road.size_px,
-        GifView::Follow => params.size_px(road),
+        GifView::Follow => params.size_px(lanes),
     };
+    let drawing = RoadDrawing::new(lanes);
     let scene = FrameScene {
-        road,
+        road: &drawing,
+        lane_ids: params.lane_ids,
         vehicles,
         collisions,
         follow,
@@ -274,11 +284,11 @@ pub fn write_gif(
             let geometry = match params.view {
                 GifView::Road => whole_road,
                 GifView::Follow => {
-                    let x_c = instant
+                    let centre = instant
                         .iter()
                         .find(|r| r.vehicle == follow)
-                        .map_or(0.0, |r| r.x_m);
-                    FrameGeometry::follow(road, params, x_c)
+                        .map_or([0.0, 0.0], |r| [r.x_m, r.y_m]);
+                    FrameGeometry::follow(lanes, params, centre)
                 }
             };
             {
@@ -319,6 +329,9 @@ pub fn write_gif(
 }
 
 #[cfg(test)]
+mod curved_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
@@ -352,7 +365,7 @@ mod tests {
         assert_eq!(frame_instants(&all, 10.0).len(), 21);
     }
 
-    fn row(vehicle: &str, x_m: f64, y_m: f64) -> TimeSeriesRow {
+    pub(super) fn row(vehicle: &str, x_m: f64, y_m: f64) -> TimeSeriesRow {
         TimeSeriesRow {
             t_s: 1.0,
             vehicle: vehicle.into(),
@@ -381,9 +394,26 @@ mod tests {
             .collect()
     }
 
+    fn merge_lanes() -> LaneRoad {
+        sim::MergeRoad::default()
+            .lane_road()
+            .unwrap_or_else(|e| panic!("{e}"))
+    }
+
     /// One frame drawn into memory with `geometry`.
     fn draw(instant: &[TimeSeriesRow], view: GifView, geometry: &FrameGeometry) -> Vec<u8> {
-        let road = sim::MergeRoad::default();
+        draw_on(&merge_lanes(), instant, view, geometry, false)
+    }
+
+    /// One frame of `lanes` drawn into memory with `geometry`.
+    pub(super) fn draw_on(
+        lanes: &LaneRoad,
+        instant: &[TimeSeriesRow],
+        view: GifView,
+        geometry: &FrameGeometry,
+        lane_ids: bool,
+    ) -> Vec<u8> {
+        let road = RoadDrawing::new(lanes);
         let vehicles = vehicles();
         let size = geometry.size_px;
         let mut buffer = vec![0u8; (size.0 * size.1 * 3) as usize];
@@ -391,6 +421,7 @@ mod tests {
             let root = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
             let scene = FrameScene {
                 road: &road,
+                lane_ids,
                 vehicles: &vehicles,
                 collisions: &[],
                 follow: "ego",
@@ -405,12 +436,11 @@ mod tests {
 
     /// One frame of the follow view, following `ego`.
     fn frame(instant: &[TimeSeriesRow]) -> Vec<u8> {
-        let road = sim::MergeRoad::default();
-        let x_c = instant
+        let centre = instant
             .iter()
             .find(|r| r.vehicle == "ego")
-            .map_or(0.0, |r| r.x_m);
-        let geometry = FrameGeometry::follow(&road, &GifParams::default(), x_c);
+            .map_or([0.0, 0.0], |r| [r.x_m, r.y_m]);
+        let geometry = FrameGeometry::follow(&merge_lanes(), &GifParams::default(), centre);
         draw(instant, GifView::Follow, &geometry)
     }
 
@@ -441,7 +471,7 @@ mod tests {
         let road = sim::MergeRoad::default();
         // The same two vehicles, 300 m apart: the follow view loses one, the road view has both.
         let instant = [row("ego", 0.0, 1.75), row("far", 300.0, 5.25)];
-        let geometry = FrameGeometry::whole_road(&road, &GifParams::default(), &instant);
+        let geometry = FrameGeometry::whole_road(&merge_lanes(), &GifParams::default(), &instant);
         assert_eq!(geometry.size_px.0, 800);
         let pixels = draw(&instant, GifView::Road, &geometry);
         let at = |(x, y): (i32, i32)| {

@@ -17,7 +17,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use planner::MergeRoad;
+use mergesim_types::lanes::LaneRoad;
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
@@ -286,10 +286,13 @@ pub fn comparison_csv(series: &[PlannerSeries<'_>]) -> String {
 }
 
 /// Writes [`PATHS_PNG`], one [`states_png`] per vehicle and [`TIME_SERIES_CSV`] into `dir`;
-/// returns the written paths in that order. Every figure's caption band says `caption`.
+/// returns the written paths in that order. Every figure's caption band says `caption`. The
+/// paths figure draws the road `lanes` (any road of lanes, curved or not), with each lane's id
+/// if `lane_ids`.
 pub fn write_comparison(
     dir: &Path,
-    road: &MergeRoad,
+    lanes: &LaneRoad,
+    lane_ids: bool,
     series: &[PlannerSeries<'_>],
     size: FigureSize,
     caption: &RunCaption,
@@ -318,7 +321,7 @@ pub fn write_comparison(
 
     let path = dir.join(PATHS_PNG);
     render_png(&path, paths_size(size, series.len()), |area| {
-        draw_paths_figure(area, road, series, &vehicles, caption).map(|_| ())
+        draw_paths_figure(area, lanes, lane_ids, series, &vehicles, caption).map(|_| ())
     })?;
     written.push(path);
 
@@ -357,13 +360,14 @@ fn states_size(size: FigureSize) -> (u32, u32) {
 /// Fig. 3 under its caption band.
 fn draw_paths_figure(
     area: &DrawingArea<BitMapBackend<'_>, Shift>,
-    road: &MergeRoad,
+    lanes: &LaneRoad,
+    lane_ids: bool,
     series: &[PlannerSeries<'_>],
     vehicles: &[String],
     caption: &RunCaption,
 ) -> Result<Vec<PanelLayout>, String> {
     let rest = draw_caption(area, &caption.line(), None)?;
-    draw_paths(&rest, road, series, vehicles)
+    draw_paths(&rest, lanes, lane_ids, series, vehicles)
 }
 
 /// Fig. 4 of vehicle `id` (`vehicle`) under its caption band, which starts with a square in

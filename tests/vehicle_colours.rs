@@ -155,7 +155,12 @@ fn a_vehicle_has_the_same_colour_in_the_recording_the_gif_and_the_figures() {
         view: GifView::Road,
         ..GifParams::default()
     };
-    let geometry = FrameGeometry::whole_road(&scenario.sim.road, &params, &series);
+    let lanes = scenario
+        .sim
+        .road
+        .lane_road()
+        .unwrap_or_else(|e| panic!("{e}"));
+    let geometry = FrameGeometry::whole_road(&lanes, &params, &series);
     let (w, frame) = first_gif_frame(&gif);
     for (_, name, x, y) in rows.iter().filter(|r| r.0 == t0) {
         let (px, py) = geometry.to_px(*x, *y);

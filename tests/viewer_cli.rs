@@ -174,6 +174,38 @@ fn gif_options_change_rate_and_size() {
     assert!(delays.iter().all(|&d| d == 20));
 }
 
+/// `--lane-ids` writes the lanes' ids into the GIF (the frames differ from those without it);
+/// on `compare` it needs `--plots` (refused with exit 2 otherwise).
+#[test]
+fn lane_ids_are_drawn_on_request() {
+    let dir = scratch("gif_lane_ids");
+    let gifs = [dir.join("plain.gif"), dir.join("ids.gif")];
+    for (gif, extra) in gifs.iter().zip([None, Some("--lane-ids")]) {
+        let mut args = vec![
+            "run",
+            "--no-rrd",
+            "--quiet",
+            "--gif",
+            gif.to_str().unwrap(),
+            "--gif-fps",
+            "1",
+            "--gif-view",
+            "road",
+        ];
+        args.extend(extra);
+        let out = merge_sim(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let (frames, w, h, _, _) = decode_gif(&gifs[0]);
+    assert_eq!(decode_gif(&gifs[1]).0, frames);
+    assert_eq!((decode_gif(&gifs[1]).1, decode_gif(&gifs[1]).2), (w, h));
+    let bytes = |p: &std::path::Path| std::fs::read(p).unwrap();
+    assert_ne!(bytes(&gifs[0]), bytes(&gifs[1]), "--lane-ids drew nothing");
+    let out = merge_sim(&["compare", "--lane-ids"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--plots"), "{}", stderr(&out));
+}
+
 #[test]
 fn bad_follow_and_gif_options_are_refused_before_the_run() {
     let dir = scratch("gif_bad");

@@ -20,6 +20,7 @@ pub mod recording_observer;
 pub mod registry;
 pub mod rng;
 pub mod road_config;
+pub mod road_drawing;
 pub mod run_log;
 pub mod safety;
 pub mod spatial;

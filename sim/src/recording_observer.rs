@@ -33,9 +33,12 @@ pub struct RecordingObserver {
 }
 
 impl RecordingObserver {
-    /// Records into `recorder`, starting with the road.
-    pub fn new(mut recorder: Recorder, road: &mergesim_types::MergeRoad) -> Result<Self, SimError> {
-        recorder.log_road(road).map_err(rec)?;
+    /// Records into `recorder`, starting with the road (as lanes).
+    pub fn new(
+        mut recorder: Recorder,
+        lanes: &mergesim_types::lanes::LaneRoad,
+    ) -> Result<Self, SimError> {
+        recorder.log_road(lanes).map_err(rec)?;
         let detail_below = recorder.params().detail_vehicles.unwrap_or(usize::MAX);
         Ok(Self {
             recorder: Some(recorder),

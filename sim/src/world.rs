@@ -70,16 +70,9 @@ pub struct World {
     steps_per_safety: u64,
     reported_collisions: usize,
     reported_edge_contacts: usize,
-    /// False on a road of lanes: the parry road-edge test still reads the straight `[sim.road]`
-    /// edges, which are not this road's, so its contacts are dropped until the edge test is
-    /// built from the lanes.
-    straight_edges: bool,
     profiler: Profiler,
     planning_pool: Option<std::sync::Arc<rayon::ThreadPool>>,
 }
-
-/// How far the flat surface under a road of lanes reaches beyond its lanes' centrelines (m).
-const FLAT_GROUND_MARGIN_M: f64 = 200.0;
 
 fn steps_for(period_s: f64, dt_s: f64) -> u64 {
     ((period_s / dt_s).round() as u64).max(1)
@@ -115,20 +108,9 @@ impl World {
         crate::config::validate_vehicles(&config, specs)?;
         let lanes = std::sync::Arc::new(config.lanes()?);
         let mut physics = PhysicsWorld::new(config.dt_s)?;
-        if config.is_straight_merge_road() {
-            physics.add_merge_road(&config.road);
-        } else {
-            // A road of lanes: a flat surface under all of it (the lanes' collider and barriers
-            // come with the lane-geometry road collider).
-            let reach_m = lanes.lanes().iter().fold(0.0_f64, |r, l| {
-                let [lo, hi] = l.centreline().bounding_box_m();
-                r.max(lo[0].abs())
-                    .max(lo[1].abs())
-                    .max(hi[0].abs())
-                    .max(hi[1].abs())
-            });
-            physics.add_flat_ground(reach_m + FLAT_GROUND_MARGIN_M);
-        }
+        // Built from the lanes, around a local origin near the road (module doc of
+        // `vehicles::PhysicsWorld`); the vehicles report the road's own coordinates.
+        physics.add_lane_road(&lanes);
         let mut agents = Vec::with_capacity(specs.len());
         for (index, spec) in specs.iter().enumerate() {
             agents.push(Agent::spawn(
@@ -145,7 +127,7 @@ impl World {
             config.v2v.clone(),
             crate::rng::SplitMix64::derive(options.seed, 1),
         )?;
-        let safety = SafetyMonitor::new(config.safety.clone(), &config.road)?;
+        let safety = SafetyMonitor::new(config.safety.clone(), lanes.clone())?;
         let metrics = agents
             .iter()
             .map(|a| {
@@ -153,13 +135,12 @@ impl World {
                     .with_paper_metrics(lanes.clone(), a.spec.target_speed_mps)
             })
             .collect();
-        let recording = RecordingObserver::new(recorder, &config.road)?;
+        let recording = RecordingObserver::new(recorder, &lanes)?;
         Ok(Self {
             steps_per_plan: steps_for(config.planner_period_s, config.dt_s),
             steps_per_log: steps_for(config.log_period_s, config.dt_s),
             steps_per_field: steps_for(config.field_log_period_s, config.dt_s),
             steps_per_safety: steps_for(config.safety_period_s, config.dt_s),
-            straight_edges: config.is_straight_merge_road(),
             config,
             lanes,
             physics,
@@ -408,9 +389,6 @@ impl World {
             })?;
             self.reported_collisions += 1;
         }
-        if !self.straight_edges {
-            self.reported_edge_contacts = self.safety.edge_contact_events().len();
-        }
         while self.reported_edge_contacts < self.safety.edge_contact_events().len() {
             let event = self.safety.edge_contact_events()[self.reported_edge_contacts].clone();
             let name = names.get(event.id as usize).cloned().unwrap_or_default();
@@ -499,10 +477,7 @@ impl World {
     }
 
     fn finish(mut self) -> Result<RunOutcome, SimError> {
-        let mut safety = self.safety.summary();
-        if !self.straight_edges {
-            safety.edge_contacts.clear();
-        }
+        let safety = self.safety.summary();
         if safety.near_miss {
             let text = format!(
                 "near miss: min gap {} m, min TTC {}",

@@ -36,7 +36,10 @@ fn body(id: u32, x_m: f64, y_m: f64, yaw_rad: f64) -> BodyState {
 /// Logs a short synthetic run: everything the world loop would log.
 fn log_run(rec: &mut Recorder) -> Result<(), RecordingError> {
     let road = MergeRoad::default();
-    rec.log_road(&road)?;
+    rec.log_road(&road.lane_road().map_err(|e| RecordingError::InvalidInput {
+        call: "lane_road",
+        reason: e.to_string(),
+    })?)?;
     let names = vec!["ego".to_string(), "obstacle".to_string()];
     for k in 0..20 {
         let t = 0.05 * k as f64;

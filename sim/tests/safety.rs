@@ -6,6 +6,11 @@ use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_4, PI};
 use planner::MergeRoad;
 use sim::safety::{BodyState, RoadEdge, SafetyError, SafetyMonitor, SafetyParams};
 
+/// The road as lanes, as the world hands it to the monitor.
+fn lanes(road: &MergeRoad) -> std::sync::Arc<mergesim_types::lanes::LaneRoad> {
+    std::sync::Arc::new(road.lane_road().unwrap())
+}
+
 fn car(id: u32, x_m: f64, y_m: f64, yaw_rad: f64, vx_mps: f64, vy_mps: f64) -> BodyState {
     BodyState {
         id,
@@ -22,7 +27,7 @@ fn car(id: u32, x_m: f64, y_m: f64, yaw_rad: f64, vx_mps: f64, vy_mps: f64) -> B
 }
 
 fn monitor() -> SafetyMonitor {
-    SafetyMonitor::new(SafetyParams::default(), &MergeRoad::default()).unwrap()
+    SafetyMonitor::new(SafetyParams::default(), lanes(&MergeRoad::default())).unwrap()
 }
 
 /// Monitor that counts only true overlap as contact (no touching tolerance).
@@ -31,7 +36,7 @@ fn exact_monitor() -> SafetyMonitor {
         contact_tolerance_m: 0.0,
         ..SafetyParams::default()
     };
-    SafetyMonitor::new(params, &MergeRoad::default()).unwrap()
+    SafetyMonitor::new(params, lanes(&MergeRoad::default())).unwrap()
 }
 
 /// Monitor without road edges, for pair tests placed anywhere.
@@ -40,7 +45,7 @@ fn pair_monitor() -> SafetyMonitor {
         check_road_edges: false,
         ..SafetyParams::default()
     };
-    SafetyMonitor::new(params, &MergeRoad::default()).unwrap()
+    SafetyMonitor::new(params, lanes(&MergeRoad::default())).unwrap()
 }
 
 /// Rotates a body about the origin by `angle_rad` and then translates it.
@@ -371,7 +376,7 @@ fn bad_input_is_an_error_not_a_panic() {
         ttc_threshold_s: -1.0,
         ..SafetyParams::default()
     };
-    assert!(SafetyMonitor::new(bad, &MergeRoad::default()).is_err());
+    assert!(SafetyMonitor::new(bad, lanes(&MergeRoad::default())).is_err());
 }
 
 #[test]

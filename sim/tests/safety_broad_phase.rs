@@ -60,8 +60,10 @@ fn compare(
         broad_phase: false,
         ..params
     };
-    let mut swept = SafetyMonitor::new(swept_params, &road).unwrap();
-    let mut all = SafetyMonitor::new(all_params, &road).unwrap();
+    let mut swept =
+        SafetyMonitor::new(swept_params, std::sync::Arc::new(road.lane_road().unwrap())).unwrap();
+    let mut all =
+        SafetyMonitor::new(all_params, std::sync::Arc::new(road.lane_road().unwrap())).unwrap();
     let mut rng = SplitMix64::new(seed);
     let mut bodies = layout(&mut rng, n, length_m);
     let dt_s = 0.05;

@@ -1,10 +1,12 @@
 //! One frame of the animation: where road coordinates fall in the picture (the follow window or
 //! the whole road) and the drawing of the road, the vehicles and the header.
 
+use mergesim_types::lanes::LaneRoad;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use sim::TimeSeriesRow;
 use sim::recording::vehicle_color;
+use sim::road_drawing::{RoadDrawing, road_middle_offset_m, road_width_m};
 use sim::safety::CollisionEvent;
 
 use super::{GifParams, GifVehicle, GifView};
@@ -24,16 +26,28 @@ const ROAD_VIEW_PX_PER_M_ACROSS: f64 = 4.0;
 /// Smallest drawn footprint (pixels along, across), so a car stays visible on a long road.
 const MIN_FOOTPRINT_PX: (f64, f64) = (8.0, 5.0);
 
-/// How road coordinates map to a frame's pixels: X to the right, Y up.
+/// Largest height of the road view when its lanes are stretched across (pixels, as a multiple
+/// of the picture's width): a road that curves far across keeps one scale instead.
+const ROAD_VIEW_MAX_STRETCHED_HEIGHT: f64 = 1.0;
+
+/// How road coordinates map to a frame's pixels: a point p is turned into the view's axes,
+/// (u, v) = R(−rotation) (p − origin), then u goes to the right and v up. The road view has no
+/// rotation and its origin at (0, 0) (u, v = X, Y); the follow view's origin is the followed
+/// vehicle's station on the middle of the road, turned so that its lane runs to the right,
+/// along a curve too.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameGeometry {
-    /// Road X at the picture's left edge (m).
+    /// The view's origin in road coordinates (m).
+    pub origin_m: [f64; 2],
+    /// The view's rotation: the road direction drawn to the right (rad).
+    pub rotation_rad: f64,
+    /// u at the picture's left edge (m).
     pub x0_m: f64,
-    /// Road Y at the top of the road area (m).
+    /// v at the top of the road area (m).
     pub y_top_m: f64,
-    /// Pixels per metre along X.
+    /// Pixels per metre along u.
     pub px_per_m_x: f64,
-    /// Pixels per metre along Y: the same as along X in the follow view; in the road view of a
+    /// Pixels per metre along v: the same as along u in the follow view; in the road view of a
     /// long road larger, so the lanes stay visible (the header says by how much).
     pub px_per_m_y: f64,
     /// Top of the road area (pixels).
@@ -43,16 +57,33 @@ pub struct FrameGeometry {
 }
 
 impl FrameGeometry {
-    /// The follow view: [`GifParams::behind_m`] behind `x_center_m` to [`GifParams::ahead_m`]
-    /// ahead, the road's whole width with [`GifParams::margin_m`] beside it, one scale.
-    pub fn follow(road: &sim::MergeRoad, params: &GifParams, x_center_m: f64) -> Self {
+    /// The follow view of a vehicle at `vehicle_m`: [`GifParams::behind_m`] behind it to
+    /// [`GifParams::ahead_m`] ahead along its lane (the nearest lane) and turned to the lane's
+    /// heading there; across, the road's whole width ([`sim::road_drawing::road_width_m`]) with
+    /// [`GifParams::margin_m`] beside it, centred on the road's middle
+    /// ([`sim::road_drawing::road_middle_offset_m`]: on the straight merge road the divider, as
+    /// before); one scale.
+    pub fn follow(lanes: &LaneRoad, params: &GifParams, vehicle_m: [f64; 2]) -> Self {
         let px_per_m = f64::from(params.width_px) / (params.behind_m + params.ahead_m);
-        let road_px = ((road.y_upper_m() - road.y_bottom_m + 2.0 * params.margin_m) * px_per_m)
-            .ceil()
-            .clamp(16.0, 4000.0);
+        let half_height_m = 0.5 * road_width_m(lanes) + params.margin_m;
+        let road_px = (2.0 * half_height_m * px_per_m).ceil().clamp(16.0, 4000.0);
+        let (origin_m, rotation_rad) = if vehicle_m.iter().all(|c| c.is_finite()) {
+            let hit = lanes.nearest_lane(vehicle_m);
+            lanes.lane(hit.lane).map_or((vehicle_m, 0.0), |l| {
+                let s = hit.frame.s_m;
+                (
+                    l.point(s, road_middle_offset_m(lanes, hit.lane)),
+                    l.heading_rad(s),
+                )
+            })
+        } else {
+            (vehicle_m, 0.0)
+        };
         Self {
-            x0_m: x_center_m - params.behind_m,
-            y_top_m: road.y_upper_m() + params.margin_m,
+            origin_m,
+            rotation_rad,
+            x0_m: -params.behind_m,
+            y_top_m: half_height_m,
             px_per_m_x: px_per_m,
             px_per_m_y: px_per_m,
             top_px: HEADER_PX,
@@ -62,8 +93,9 @@ impl FrameGeometry {
 
     /// The road view: the whole road, and every position in `rows`, across the picture's
     /// width; the vehicles' names in a band above and below the road.
-    pub fn whole_road(road: &sim::MergeRoad, params: &GifParams, rows: &[TimeSeriesRow]) -> Self {
-        let (mut lo, mut hi) = (road.start_x_m, road.end_x_m);
+    pub fn whole_road(lanes: &LaneRoad, params: &GifParams, rows: &[TimeSeriesRow]) -> Self {
+        let [blo, bhi] = RoadDrawing::new(lanes).bounds_m;
+        let (mut lo, mut hi) = (blo[0], bhi[0]);
         for r in rows.iter().filter(|r| r.x_m.is_finite()) {
             lo = lo.min(r.x_m - 5.0);
             hi = hi.max(r.x_m + 5.0);
@@ -71,13 +103,20 @@ impl FrameGeometry {
         let span = (hi - lo).max(1.0);
         let pad = 0.01 * span;
         let px_per_m_x = f64::from(params.width_px) / (span + 2.0 * pad);
-        let px_per_m_y = px_per_m_x.max(ROAD_VIEW_PX_PER_M_ACROSS);
-        let road_px = ((road.y_upper_m() - road.y_bottom_m + 2.0 * params.margin_m) * px_per_m_y)
-            .ceil()
-            .clamp(16.0, 4000.0);
+        let height_m = bhi[1] - blo[1] + 2.0 * params.margin_m;
+        let stretched = px_per_m_x.max(ROAD_VIEW_PX_PER_M_ACROSS);
+        let max_height_px = ROAD_VIEW_MAX_STRETCHED_HEIGHT * f64::from(params.width_px);
+        let px_per_m_y = if height_m * stretched <= max_height_px {
+            stretched
+        } else {
+            px_per_m_x.max(max_height_px / height_m)
+        };
+        let road_px = (height_m * px_per_m_y).ceil().clamp(16.0, 4000.0);
         Self {
+            origin_m: [0.0, 0.0],
+            rotation_rad: 0.0,
             x0_m: lo - pad,
-            y_top_m: road.y_upper_m() + params.margin_m,
+            y_top_m: bhi[1] + params.margin_m,
             px_per_m_x,
             px_per_m_y,
             top_px: HEADER_PX + LABEL_BAND_PX,
@@ -88,11 +127,22 @@ impl FrameGeometry {
         }
     }
 
+    /// The view's axes (u, v) of road point (x, y) (m).
+    pub fn to_view_m(&self, x_m: f64, y_m: f64) -> (f64, f64) {
+        let (dx, dy) = (x_m - self.origin_m[0], y_m - self.origin_m[1]);
+        if self.rotation_rad == 0.0 {
+            return (dx, dy);
+        }
+        let (s, c) = self.rotation_rad.sin_cos();
+        (c * dx + s * dy, -s * dx + c * dy)
+    }
+
     /// The pixel of road point (x, y).
     pub fn to_px(&self, x_m: f64, y_m: f64) -> (i32, i32) {
+        let (u, v) = self.to_view_m(x_m, y_m);
         (
-            ((x_m - self.x0_m) * self.px_per_m_x).round() as i32,
-            (f64::from(self.top_px) + (self.y_top_m - y_m) * self.px_per_m_y).round() as i32,
+            ((u - self.x0_m) * self.px_per_m_x).round() as i32,
+            (f64::from(self.top_px) + (self.y_top_m - v) * self.px_per_m_y).round() as i32,
         )
     }
 }
@@ -107,7 +157,9 @@ pub(super) fn footprint(x: f64, y: f64, yaw: f64, length: f64, width: f64) -> [(
 
 /// What one frame shows besides its instant.
 pub(super) struct FrameScene<'a> {
-    pub(super) road: &'a sim::MergeRoad,
+    pub(super) road: &'a RoadDrawing,
+    /// Write each lane's id on the road.
+    pub(super) lane_ids: bool,
     pub(super) vehicles: &'a [GifVehicle],
     pub(super) collisions: &'a [CollisionEvent],
     pub(super) follow: &'a str,
@@ -124,6 +176,7 @@ pub(super) fn draw_frame(
 ) -> Result<(), String> {
     let FrameScene {
         road,
+        lane_ids,
         vehicles,
         collisions,
         follow,
@@ -136,32 +189,45 @@ pub(super) fn draw_frame(
     let t_s = instant.first().map_or(0.0, |r| r.t_s);
     let followed = instant.iter().find(|r| r.vehicle == follow);
     let to_px = |x: f64, y: f64| geometry.to_px(x, y);
-    // Merge section.
-    let (mx0, my0) = to_px(road.merge_start_x_m, road.y_upper_m());
-    let (mx1, my1) = to_px(road.merge_end_x_m, road.y_bottom_m);
-    root.draw(&Rectangle::new(
-        [(mx0, my0), (mx1, my1)],
-        RGBColor(75, 58, 38).filled(),
-    ))
-    .map_err(|x| e(&x))?;
-    // Edges and divider.
+    // Merge sections (the tapering stretch of each lane that ends).
     let line = |pts: &[[f64; 2]]| pts.iter().map(|p| to_px(p[0], p[1])).collect::<Vec<_>>();
-    for edge in [road.upper_edge_polyline(), road.lower_edge_polyline()] {
+    for section in &road.merge_sections {
+        root.draw(&Polygon::new(line(section), RGBColor(75, 58, 38).filled()))
+            .map_err(|x| e(&x))?;
+    }
+    // Outer edges solid, dividers dashed, closed lane ends.
+    for edge in &road.outer_edges {
         root.draw(&PathElement::new(
-            line(&edge),
+            line(edge),
             ShapeStyle::from(&RGBColor(230, 230, 230)).stroke_width(2),
         ))
         .map_err(|x| e(&x))?;
     }
-    let divider = [
-        [road.start_x_m, road.y_lane_m()],
-        [road.merge_end_x_m, road.y_lane_m()],
-    ];
-    root.draw(&PathElement::new(
-        line(&divider),
-        ShapeStyle::from(&RGBColor(240, 200, 60)).stroke_width(1),
-    ))
-    .map_err(|x| e(&x))?;
+    for dash in road.divider_dashes() {
+        root.draw(&PathElement::new(
+            line(&dash),
+            ShapeStyle::from(&RGBColor(240, 200, 60)).stroke_width(1),
+        ))
+        .map_err(|x| e(&x))?;
+    }
+    for end in &road.closed_ends {
+        root.draw(&PathElement::new(
+            line(end),
+            ShapeStyle::from(&RGBColor(230, 60, 40)).stroke_width(3),
+        ))
+        .map_err(|x| e(&x))?;
+    }
+    if lane_ids {
+        for label in &road.lane_labels {
+            let (x, y) = to_px(label.at_m[0], label.at_m[1]);
+            root.draw(&Text::new(
+                label.text.clone(),
+                (x - 14, y - 6),
+                font(11).color(&RGBColor(200, 200, 255)),
+            ))
+            .map_err(|x| e(&x))?;
+        }
+    }
     // Vehicles: footprints first, names on top.
     let mut labels = Vec::new();
     for row in instant {

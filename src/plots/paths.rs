@@ -1,30 +1,43 @@
 //! The paper's Fig. 3: the road and each vehicle's path, one panel per planner.
 
-use planner::MergeRoad;
+use mergesim_types::lanes::LaneRoad;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use sim::road_drawing::RoadDrawing;
 
 use super::legend::{LegendEntry, Mark, split_for_legend};
 use super::{
     PanelLayout, PlannerSeries, collision_marks, font, padded_range, panel_layout, vehicle_rgb,
 };
 
-/// Fig. 3: the road (edges, divider, merge section shaded) and each vehicle's path, one panel
-/// per planner; the first vehicle solid, the others dashed, in the vehicles' colours (the
+/// Fig. 3: the road (any road of lanes: outer edges solid, dividers dashed, closed lane ends,
+/// merge sections shaded, lane ids if `lane_ids`) and each vehicle's path, one panel per
+/// planner; the first vehicle solid, the others dashed, in the vehicles' colours (the
 /// recording's and the GIF's, by id: `vehicles` is in id order); collisions marked with red
 /// crosses; each panel's legend right of its chart. Returns where each panel was drawn.
 pub(super) fn draw_paths(
     area: &DrawingArea<BitMapBackend<'_>, Shift>,
-    road: &MergeRoad,
+    lanes: &LaneRoad,
+    lane_ids: bool,
     series: &[PlannerSeries<'_>],
     vehicles: &[String],
 ) -> Result<Vec<PanelLayout>, String> {
+    let road = RoadDrawing::new(lanes);
     let x_range = padded_range(
         series.iter().flat_map(|s| s.rows.iter().map(|r| r.x_m)),
         0.01,
         10.0,
     );
-    let y_range = (road.y_bottom_m - 0.5)..(road.y_upper_m() + 0.5);
+    // Across: the road over the drawn X range (on the straight merge road its two edges), and
+    // every path.
+    let [mut y_lo, mut y_hi] = road.y_range_over_m(lanes, [x_range.start, x_range.end]);
+    for r in series.iter().flat_map(|s| s.rows.iter()) {
+        if r.y_m.is_finite() {
+            y_lo = y_lo.min(r.y_m);
+            y_hi = y_hi.max(r.y_m);
+        }
+    }
+    let y_range = (y_lo - 0.5)..(y_hi + 0.5);
     let style_of = |k: usize| vehicle_rgb(k).stroke_width(2);
     let mut entries: Vec<LegendEntry> = vehicles
         .iter()
@@ -68,38 +81,49 @@ pub(super) fn draw_paths(
             .light_line_style(WHITE)
             .draw()
             .map_err(|e| e.to_string())?;
-        // Merge section, shaded as in the paper.
+        // Merge sections, shaded as in the paper.
         let merge = RGBColor(255, 200, 120).mix(0.35);
         chart
-            .draw_series(std::iter::once(Rectangle::new(
-                [
-                    (road.merge_start_x_m, road.y_bottom_m),
-                    (road.merge_end_x_m, road.y_upper_m()),
-                ],
-                merge.filled(),
-            )))
+            .draw_series(road.merge_sections.iter().map(|section| {
+                Polygon::new(
+                    section.iter().map(|p| (p[0], p[1])).collect::<Vec<_>>(),
+                    merge.filled(),
+                )
+            }))
             .map_err(|e| e.to_string())?;
         let edge = BLACK.stroke_width(2);
-        for line in [road.lower_edge_polyline(), road.upper_edge_polyline()] {
+        for line in &road.outer_edges {
             chart
-                .draw_series(LineSeries::new(
-                    line.into_iter().map(|p| (p[0], p[1])),
-                    edge,
+                .draw_series(LineSeries::new(line.iter().map(|p| (p[0], p[1])), edge))
+                .map_err(|e| e.to_string())?;
+        }
+        for line in &road.dividers {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    line.iter().map(|p| (p[0], p[1])),
+                    8,
+                    6,
+                    RGBColor(120, 120, 120).stroke_width(1),
                 ))
                 .map_err(|e| e.to_string())?;
         }
-        let divider_end = road.merge_end_x_m.min(road.end_x_m);
-        chart
-            .draw_series(DashedLineSeries::new(
-                [
-                    (road.start_x_m, road.y_lane_m()),
-                    (divider_end, road.y_lane_m()),
-                ],
-                8,
-                6,
-                RGBColor(120, 120, 120).stroke_width(1),
-            ))
-            .map_err(|e| e.to_string())?;
+        for end in &road.closed_ends {
+            chart
+                .draw_series(LineSeries::new(
+                    end.iter().map(|p| (p[0], p[1])),
+                    RGBColor(200, 40, 30).stroke_width(3),
+                ))
+                .map_err(|e| e.to_string())?;
+        }
+        if lane_ids {
+            chart
+                .draw_series(
+                    road.lane_labels
+                        .iter()
+                        .map(|l| Text::new(l.text.clone(), (l.at_m[0], l.at_m[1]), font(12))),
+                )
+                .map_err(|e| e.to_string())?;
+        }
         for (k, vehicle) in vehicles.iter().enumerate() {
             let points: Vec<(f64, f64)> = s
                 .rows

@@ -11,6 +11,12 @@ fn caption() -> RunCaption {
     }
 }
 
+fn merge_lanes() -> LaneRoad {
+    planner::MergeRoad::default()
+        .lane_road()
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// Draws a figure into memory: its RGB pixels and what `draw` returned.
 fn render_in_memory<T>(
     size: (u32, u32),
@@ -139,7 +145,8 @@ fn legends_cover_no_data_in_the_first_two_seconds() {
     let (buffer, layouts) = render_in_memory(dims, |area| {
         draw_paths_figure(
             area,
-            &MergeRoad::default(),
+            &merge_lanes(),
+            false,
             &series,
             &["ego".to_string()],
             &caption(),
@@ -290,7 +297,7 @@ fn figures_are_png_files_and_no_temporary_file_is_left() {
         width_px: 400,
         panel_height_px: 120,
     };
-    let written = write_comparison(&dir, &MergeRoad::default(), &series, size, &caption()).unwrap();
+    let written = write_comparison(&dir, &merge_lanes(), false, &series, size, &caption()).unwrap();
     let names: Vec<String> = written
         .iter()
         .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
@@ -330,7 +337,8 @@ fn figures_are_png_files_and_no_temporary_file_is_left() {
 fn empty_series_is_an_error_not_a_panic() {
     let err = write_comparison(
         Path::new("."),
-        &MergeRoad::default(),
+        &merge_lanes(),
+        false,
         &[],
         FigureSize::default(),
         &caption(),
@@ -354,4 +362,82 @@ fn a_missing_folder_is_rejected() {
     );
     assert_eq!(states_png("../a"), "states__a.png");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Fig. 3 on the 300 m-radius curved merge road: the outer edges are drawn (black) along the
+/// curve, every vertex of them inside the plotting area on a black pixel, and the path of a
+/// vehicle driving round it in its colour.
+#[test]
+fn the_paths_figure_draws_a_curved_road() {
+    let spec = mergesim_types::lanes::curved_merge_spec(&planner::MergeRoad::default(), 300.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let lanes = LaneRoad::new(&spec).unwrap_or_else(|e| panic!("{e}"));
+    let lane = lanes
+        .lane(mergesim_types::lanes::THROUGH_LANE_ID)
+        .unwrap_or_else(|| panic!("no through lane"));
+    let rows: Vec<TimeSeriesRow> = (0..=300)
+        .map(|k| {
+            let t = 0.1 * f64::from(k);
+            let [x_m, y_m] = lane.point(10.0 + 10.0 * t, 0.0);
+            TimeSeriesRow {
+                t_s: t,
+                vehicle: "ego".into(),
+                x_m,
+                y_m,
+                yaw_rad: 0.0,
+                yaw_rate_radps: 0.0,
+                sideslip_rad: 0.0,
+                speed_mps: 10.0,
+                planned_speed_mps: 10.0,
+                accel_long_mps2: 0.0,
+                accel_lat_mps2: 0.0,
+            }
+        })
+        .collect();
+    let series = [PlannerSeries {
+        planner: "pf-iso",
+        rows: &rows,
+        collisions: &[],
+    }];
+    let size = FigureSize {
+        width_px: 900,
+        panel_height_px: 700,
+    };
+    let dims = paths_size(size, 1);
+    let (buffer, layouts) = render_in_memory(dims, |area| {
+        draw_paths_figure(
+            area,
+            &lanes,
+            true,
+            &series,
+            &["ego".to_string()],
+            &caption(),
+        )
+    });
+    let layout = &layouts[0];
+    let black = [0u8, 0, 0];
+    let (mut inside, mut on_edge) = (0usize, 0usize);
+    for p in sim::road_drawing::RoadDrawing::new(&lanes)
+        .outer_edges
+        .iter()
+        .flatten()
+    {
+        let px = layout.to_px(p[0], p[1]);
+        if !layout.plot_px.contains(px) {
+            continue;
+        }
+        inside += 1;
+        let seen = (-1..=1).any(|dx| {
+            (-1..=1).any(|dy| pixel(&buffer, dims.0, (px.0 + dx, px.1 + dy)) == Some(black))
+        });
+        on_edge += usize::from(seen);
+    }
+    assert!(inside > 300, "{inside}");
+    assert!(
+        on_edge as f64 >= 0.97 * inside as f64,
+        "{on_edge} of {inside}"
+    );
+    let points =
+        |_: usize| -> Vec<(f64, f64, f64)> { rows.iter().map(|r| (r.t_s, r.x_m, r.y_m)).collect() };
+    assert_first_seconds_visible(&buffer, dims.0, &layouts, &points, vehicle_rgb(0));
 }

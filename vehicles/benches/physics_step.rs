@@ -24,7 +24,7 @@ const STEPS_PER_SCENE: u64 = 2000;
 fn scene() -> (PhysicsWorld, Vec<Vehicle>) {
     let road = MergeRoad::default();
     let mut world = PhysicsWorld::new(DT_S).expect("valid dt");
-    world.add_merge_road(&road);
+    world.add_lane_road(&road.lane_road().expect("the default road is valid"));
     let params = VehicleParams::default();
     let mut cars = Vec::with_capacity(VEHICLES);
     for i in 0..VEHICLES / 2 {

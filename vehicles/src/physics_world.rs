@@ -8,7 +8,7 @@ use rapier3d::prelude::{
 
 use crate::collision_groups;
 use crate::error::VehicleError;
-use crate::road_collider::{RoadColliderParams, RoadColliders, build_merge_road};
+use crate::road_collider::{RoadColliderParams, RoadColliders, build_lane_road, local_origin_for};
 
 /// Standard gravity used by the world and by the vehicles' static loads (m/s²).
 pub const GRAVITY_MPS2: f64 = 9.81;
@@ -24,10 +24,26 @@ pub const FALLBACK_GROUND_HALF_EXTENT_M: f64 = 1000.0;
 
 /// World frame: X along the road, Y left, Z up, gravity (0, 0, −9.81). Rapier works in `f32`;
 /// this wrapper and the vehicles speak `f64` SI.
+///
+/// # Local origin
+/// Rapier's `f32` resolves 0.5 mm at 6 km but 61 µm below 1 km. Every position handed to
+/// Rapier is therefore taken relative to a *local origin* (m, in the road's coordinates):
+/// (0, 0) until [`add_lane_road`](Self::add_lane_road) sets it from the road
+/// ([`local_origin_for`]: (0, 0) for a road centred within 2048 m of the origin, else the road
+/// bounds' centre snapped to 1024 m). The vehicles convert at their boundary ([`crate::Vehicle::spawn`],
+/// [`crate::Vehicle::kinematics`], [`crate::Vehicle::wheel_telemetry`]): everything they take
+/// and give is in the road's own coordinates. Only what is read straight from Rapier
+/// ([`rapier`](Self::rapier), [`bodies`](Self::bodies), [`colliders`](Self::colliders), scene
+/// queries) is local; convert with [`to_local_m`](Self::to_local_m) /
+/// [`to_world_m`](Self::to_world_m).
 pub struct PhysicsWorld {
     world: RapierWorld,
     dt_s: f64,
     steps: u64,
+    /// The local origin (m, road coordinates) Rapier's coordinates are relative to.
+    origin_m: [f64; 2],
+    /// True once the origin is in use (a body or a road surface was added) or was set.
+    origin_fixed: bool,
     /// The colliders wheel rays can stand on (module doc of [`Self::cast_road_ray`]).
     road_surfaces: Vec<ColliderHandle>,
 }
@@ -55,6 +71,8 @@ impl PhysicsWorld {
             world,
             dt_s,
             steps: 0,
+            origin_m: [0.0, 0.0],
+            origin_fixed: false,
             road_surfaces: Vec::new(),
         })
     }
@@ -115,20 +133,64 @@ impl PhysicsWorld {
         )
     }
 
-    /// Adds the merge road: surface plus edge barriers along the upper edge and along each
-    /// piece of the piecewise lower edge (`road.lower_edge_polyline()`), with default
-    /// [`RoadColliderParams`]. Never panics: degenerate pieces are skipped.
-    pub fn add_merge_road(&mut self, road: &mergesim_types::MergeRoad) -> RoadColliders {
-        self.add_merge_road_with(road, &RoadColliderParams::default())
+    /// The local origin (m, road coordinates) that Rapier's coordinates are relative to.
+    pub fn local_origin_m(&self) -> [f64; 2] {
+        self.origin_m
     }
 
-    /// [`add_merge_road`](Self::add_merge_road) with explicit barrier / surface dimensions.
-    pub fn add_merge_road_with(
+    /// Sets the local origin (m, road coordinates) instead of letting
+    /// [`add_lane_road`](Self::add_lane_road) choose it. Only before anything is added: an
+    /// error once a rigid body or a road surface exists, or for a non-finite origin.
+    pub fn set_local_origin_m(&mut self, origin_m: [f64; 2]) -> Result<(), VehicleError> {
+        for (name, v) in [("origin_m[0]", origin_m[0]), ("origin_m[1]", origin_m[1])] {
+            if !v.is_finite() {
+                return Err(VehicleError::invalid(name, v, "must be finite"));
+            }
+        }
+        if !(self.world.bodies.is_empty() && self.road_surfaces.is_empty()) {
+            return Err(VehicleError::invalid(
+                "origin_m",
+                origin_m[0],
+                "the local origin can only be set before any body or road is added",
+            ));
+        }
+        self.origin_m = origin_m;
+        self.origin_fixed = true;
+        Ok(())
+    }
+
+    /// A point of the road's coordinates in Rapier's (local) coordinates (m).
+    pub fn to_local_m(&self, p_m: [f64; 2]) -> [f64; 2] {
+        [p_m[0] - self.origin_m[0], p_m[1] - self.origin_m[1]]
+    }
+
+    /// A point of Rapier's (local) coordinates in the road's coordinates (m).
+    pub fn to_world_m(&self, p_m: [f64; 2]) -> [f64; 2] {
+        [p_m[0] + self.origin_m[0], p_m[1] + self.origin_m[1]]
+    }
+
+    /// Adds a road made of lanes: a flat surface under it plus edge barriers along each piece
+    /// of the drivable area's outer edges (closed lane ends included), with default
+    /// [`RoadColliderParams`]. Never panics: degenerate pieces are skipped.
+    ///
+    /// If no rigid body and no road surface has been added yet and the origin was not set with
+    /// [`set_local_origin_m`](Self::set_local_origin_m), this first sets the local origin from
+    /// the road ([`local_origin_for`]); otherwise the road is built around the origin in use.
+    pub fn add_lane_road(&mut self, lanes: &mergesim_types::lanes::LaneRoad) -> RoadColliders {
+        self.add_lane_road_with(lanes, &RoadColliderParams::default())
+    }
+
+    /// [`add_lane_road`](Self::add_lane_road) with explicit barrier / surface dimensions.
+    pub fn add_lane_road_with(
         &mut self,
-        road: &mergesim_types::MergeRoad,
+        lanes: &mergesim_types::lanes::LaneRoad,
         params: &RoadColliderParams,
     ) -> RoadColliders {
-        let colliders = build_merge_road(&mut self.world, road, params);
+        if !self.origin_fixed && self.world.bodies.is_empty() && self.road_surfaces.is_empty() {
+            self.origin_m = local_origin_for(lanes);
+        }
+        self.origin_fixed = true;
+        let colliders = build_lane_road(&mut self.world, lanes, params, self.origin_m);
         self.road_surfaces.push(colliders.surface);
         self.refresh_queries();
         colliders
@@ -137,7 +199,7 @@ impl PhysicsWorld {
     /// Inserts a fixed collider the wheels can stand on (a ramp, a bump, a second pad), in the
     /// road-surface collision groups. Wheel rays see only the colliders added through this
     /// method, [`add_flat_ground`](Self::add_flat_ground) and
-    /// [`add_merge_road`](Self::add_merge_road): a collider inserted through
+    /// [`add_lane_road`](Self::add_lane_road): a collider inserted through
     /// [`rapier_mut`](Self::rapier_mut) is solid for the chassis (if its groups say so) but
     /// invisible to the wheels.
     pub fn add_road_surface(&mut self, collider: ColliderBuilder) -> ColliderHandle {
@@ -201,7 +263,7 @@ impl PhysicsWorld {
     /// First road-surface hit of a ray (wheel-ray groups), with its normal.
     ///
     /// The ray is cast against the few road-surface colliders directly (those added by
-    /// [`add_flat_ground`](Self::add_flat_ground), [`add_merge_road`](Self::add_merge_road) and
+    /// [`add_flat_ground`](Self::add_flat_ground), [`add_lane_road`](Self::add_lane_road) and
     /// [`add_road_surface`](Self::add_road_surface)), not through rapier's query pipeline, whose
     /// tree also holds every chassis: the same parry ray cast on the same shapes at the same
     /// poses (so the same hit, bit for bit, as `tests` checks against the pipeline), without
@@ -269,7 +331,11 @@ mod tests {
     #[test]
     fn direct_road_rays_hit_what_the_query_pipeline_hits_bit_for_bit() {
         let mut world = PhysicsWorld::new(0.002).unwrap_or_else(|e| panic!("{e}"));
-        world.add_merge_road(&mergesim_types::MergeRoad::default());
+        world.add_lane_road(
+            &mergesim_types::MergeRoad::default()
+                .lane_road()
+                .unwrap_or_else(|e| panic!("{e}")),
+        );
         // A tilted ramp overlapping the road, and chassis boxes (invisible to wheel rays) in
         // the pipeline's tree.
         world.add_road_surface(

@@ -153,8 +153,10 @@ impl Vehicle {
             ));
         }
         world.refresh_queries();
+        // Rapier's coordinates are relative to the world's local origin.
+        let [x_local_m, y_local_m] = world.to_local_m([x_m, y_m]);
         let probe = Ray::new(
-            to_vector([x_m, y_m, SPAWN_PROBE_HEIGHT_M]),
+            to_vector([x_local_m, y_local_m, SPAWN_PROBE_HEIGHT_M]),
             Vector::new(0.0, 0.0, -1.0),
         );
         let ground_z = world
@@ -177,7 +179,7 @@ impl Vehicle {
         );
         let body = RigidBodyBuilder::dynamic()
             .pose(Pose::from_parts(
-                to_vector([x_m, y_m, ground_z + params.cog_height_m]),
+                to_vector([x_local_m, y_local_m, ground_z + params.cog_height_m]),
                 rotation,
             ))
             .linvel(to_vector([c * speed_mps, s * speed_mps, 0.0]))
@@ -333,6 +335,7 @@ impl Vehicle {
         }
         let dt = world.dt_s();
         let g = world.gravity_mps2();
+        let local_origin_m = world.local_origin_m();
         let (translation, q, linvel, angvel, com) = {
             let body = world
                 .bodies()
@@ -405,7 +408,12 @@ impl Vehicle {
                 v_lat_mps: dot(v_contact, wheel_y),
                 normal_cos: dot(normal, up),
             };
-            self.telemetry[i].contact_point_m = contact_point;
+            // Reported in the road's coordinates (Rapier's are relative to the local origin).
+            self.telemetry[i].contact_point_m = [
+                contact_point[0] + local_origin_m[0],
+                contact_point[1] + local_origin_m[1],
+                contact_point[2],
+            ];
             let WheelForces {
                 normal_load_n,
                 fx_n,
@@ -458,9 +466,10 @@ impl Vehicle {
         let dt = world.dt_s();
         let ax_w = (v[0] - self.previous_linvel_mps[0]) / dt;
         let ay_w = (v[1] - self.previous_linvel_mps[1]) / dt;
+        let [x_m, y_m] = world.to_world_m([p[0], p[1]]);
         Kinematics {
-            x_m: p[0],
-            y_m: p[1],
+            x_m,
+            y_m,
             z_m: p[2],
             yaw_rad: yaw,
             pitch_rad: pitch,

@@ -113,7 +113,7 @@ pub struct WheelTelemetry {
     pub fx_n: f64,
     /// Lateral tyre force applied (N, wheel frame).
     pub fy_n: f64,
-    /// Contact point (m, world).
+    /// Contact point (m, world: the road's coordinates, not Rapier's local ones).
     pub contact_point_m: [f64; 3],
     /// Brake torque actually applied after ABS (N·m).
     pub applied_brake_torque_nm: f64,

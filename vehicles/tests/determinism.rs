@@ -11,7 +11,7 @@ fn run_merge_road() -> Vec<u64> {
     let road = MergeRoad::default();
     let dt = 0.002;
     let mut world = PhysicsWorld::new(dt).unwrap();
-    world.add_merge_road(&road);
+    world.add_lane_road(&road.lane_road().expect("the default road is valid"));
     let starts = [
         ("bmw_320i", 0.0, Lane::Lower, 20.0),
         ("ford_escort", 5.0, Lane::Upper, 15.0),

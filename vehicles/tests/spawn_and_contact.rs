@@ -108,7 +108,7 @@ fn edge_barriers_stop_cars() {
         (60.0, Lane::Lower, 0.4),
     ] {
         let mut world = PhysicsWorld::new(0.002).unwrap();
-        let colliders = world.add_merge_road(&road);
+        let colliders = world.add_lane_road(&road.lane_road().unwrap());
         let mut car =
             Vehicle::spawn(&mut world, &p, x0, road.lane_center_y_m(lane), yaw, 12.0).unwrap();
         let mut touched_edge = false;
@@ -130,12 +130,7 @@ fn edge_barriers_stop_cars() {
                     "through the upper edge at {corner:?}"
                 );
             }
-            let edges: Vec<_> = colliders
-                .lower_edge
-                .iter()
-                .copied()
-                .chain(colliders.upper_edge)
-                .collect();
+            let edges = &colliders.barriers;
             touched_edge |= edges.iter().any(|&edge| {
                 world
                     .narrow_phase()

@@ -1,7 +1,8 @@
 //! What the recording logs: the road, the vehicles' boxes, planned and received paths, the
 //! potential fields, the follow frame, the field's colour bar, time series and events.
 
-use mergesim_types::{MergeRoad, PathPoint, SharedLocalPath};
+use mergesim_types::lanes::LaneRoad;
+use mergesim_types::{PathPoint, SharedLocalPath};
 use rerun::components::{Color, MarkerShape};
 use rerun::{
     Boxes2D, Image, LineStrips2D, Points2D, Scalars, SeriesLines, SeriesPoints, TextLog,
@@ -32,22 +33,35 @@ pub(super) const OVERVIEW_LENGTH_M: f64 = 750.0;
 /// Half height (m) of the whole-road view's fixed bounds.
 pub(super) const OVERVIEW_HALF_HEIGHT_M: f64 = 16.0;
 
-/// The whole-road view's frame `world/overview` for `road`: its origin at the road's start
-/// (X) and centre line (Y), Y flipped (up on screen), and scaled so that a road longer than
-/// [`OVERVIEW_LENGTH_M`] fits the view's fixed bounds (a shorter one keeps 1 m = 1 m). Returns
-/// (translation, scale): a world point p appears in the view at scale · R⁻¹ (p − translation).
-pub(super) fn overview_frame(road: &MergeRoad) -> ([f32; 3], f32) {
-    let length_m = road.end_x_m - road.start_x_m;
-    let scale = if length_m.is_finite() && length_m > OVERVIEW_LENGTH_M {
+/// The whole-road view's frame `world/overview` for a road whose bounds are `bounds_m`
+/// (`[min, max]`, m): its origin at the bounds' left end (X) and vertical centre (Y), Y flipped
+/// (up on screen), and scaled so that a road longer than [`OVERVIEW_LENGTH_M`] or higher than
+/// twice [`OVERVIEW_HALF_HEIGHT_M`] fits the view's fixed bounds (a smaller one keeps
+/// 1 m = 1 m). Returns (translation, scale): a world point p appears in the view at
+/// scale · R⁻¹ (p − translation). On the straight merge road: the road's start and centre line.
+pub(super) fn overview_frame(bounds_m: [[f64; 2]; 2]) -> ([f32; 3], f32) {
+    let [lo, hi] = bounds_m;
+    let length_m = hi[0] - lo[0];
+    let height_m = hi[1] - lo[1];
+    let by_length = if length_m.is_finite() && length_m > OVERVIEW_LENGTH_M {
         OVERVIEW_LENGTH_M / length_m
     } else {
         1.0
     };
-    let centre_y_m = 0.5 * (road.y_bottom_m + road.y_upper_m());
-    (
-        [road.start_x_m as f32, centre_y_m as f32, 0.0],
-        scale as f32,
-    )
+    let by_height = if height_m.is_finite() && height_m > 2.0 * OVERVIEW_HALF_HEIGHT_M {
+        2.0 * OVERVIEW_HALF_HEIGHT_M / height_m
+    } else {
+        1.0
+    };
+    let scale = by_length.min(by_height);
+    // A road scaled by its height is centred along X in the view.
+    let x0_m = if by_height < by_length {
+        0.5 * (lo[0] + hi[0]) - 0.5 * OVERVIEW_LENGTH_M / scale
+    } else {
+        lo[0]
+    };
+    let centre_y_m = 0.5 * (lo[1] + hi[1]);
+    ([x0_m as f32, centre_y_m as f32, 0.0], scale as f32)
 }
 
 /// Colour of event markers by level.
@@ -61,53 +75,75 @@ fn event_color(level: EventLevel) -> Color {
 }
 
 impl Recorder {
-    /// Logs the road (static): edges, lane divider and the merge section; and the static frame
-    /// of the whole-road view.
-    pub fn log_road(&mut self, road: &MergeRoad) -> Result<(), RecordingError> {
-        let Some(active) = &self.active else {
+    /// Logs the road made of lanes (static): the drivable area's outer edges (solid), the
+    /// dividers between same-direction lanes (dashed), the closed ends of lanes that end, the
+    /// merge sections (the tapering stretch of each ending lane, a translucent band) and, with
+    /// [`RecorderParams::lane_ids`](super::RecorderParams::lane_ids), each lane's id; and the
+    /// static frame of the whole-road view.
+    pub fn log_road(&mut self, lanes: &LaneRoad) -> Result<(), RecordingError> {
+        let Some(active) = &mut self.active else {
             return Ok(());
         };
-        road.validate().map_err(|e| RecordingError::InvalidInput {
-            call: "log_road",
-            reason: e.to_string(),
-        })?;
+        active.lanes = Some(lanes.clone());
+        let drawing = crate::road_drawing::RoadDrawing::new(lanes);
         let to_2d = |p: &[f64; 2]| [p[0] as f32, p[1] as f32];
-        let upper: Vec<[f32; 2]> = road.upper_edge_polyline().iter().map(to_2d).collect();
-        let lower: Vec<[f32; 2]> = road.lower_edge_polyline().iter().map(to_2d).collect();
+        let strips = |lines: &[Vec<[f64; 2]>]| -> Vec<Vec<[f32; 2]>> {
+            lines
+                .iter()
+                .map(|l| l.iter().map(to_2d).collect())
+                .collect()
+        };
         active.stream.log_static(
             "world/road/edges",
-            &LineStrips2D::new([upper, lower])
+            &LineStrips2D::new(strips(&drawing.outer_edges))
                 .with_colors([Color::from_rgb(230, 230, 230)])
                 .with_radii([self.params.road_line_radius_m as f32])
                 .with_draw_order(DRAW_ROAD),
         )?;
-        let y_lane = road.y_lane_m() as f32;
         active.stream.log_static(
             "world/road/divider",
-            &LineStrips2D::new([[
-                [road.start_x_m as f32, y_lane],
-                [road.merge_end_x_m as f32, y_lane],
-            ]])
-            .with_colors([Color::from_rgb(240, 200, 60)])
-            .with_radii([0.5 * self.params.road_line_radius_m as f32])
-            .with_draw_order(DRAW_ROAD),
+            &LineStrips2D::new(strips(&drawing.divider_dashes()))
+                .with_colors([Color::from_rgb(240, 200, 60)])
+                .with_radii([0.5 * self.params.road_line_radius_m as f32])
+                .with_draw_order(DRAW_ROAD),
         )?;
-        let half_length = 0.5 * (road.merge_end_x_m - road.merge_start_x_m);
-        let half_width = 0.5 * (road.y_upper_m() - road.y_bottom_m);
-        active.stream.log_static(
-            "world/road/merge_section",
-            &Boxes2D::from_centers_and_half_sizes(
-                [[
-                    (road.merge_start_x_m + half_length) as f32,
-                    (road.y_bottom_m + half_width) as f32,
-                ]],
-                [[half_length as f32, half_width as f32]],
-            )
-            .with_colors([Color::from_unmultiplied_rgba(255, 140, 0, 50)])
-            .with_draw_order(DRAW_MERGE_SECTION),
-        )?;
+        if !drawing.closed_ends.is_empty() {
+            let ends: Vec<Vec<[f64; 2]>> = drawing.closed_ends.iter().map(|e| e.to_vec()).collect();
+            active.stream.log_static(
+                "world/road/lane_ends",
+                &LineStrips2D::new(strips(&ends))
+                    .with_colors([Color::from_rgb(230, 60, 40)])
+                    .with_radii([1.5 * self.params.road_line_radius_m as f32])
+                    .with_draw_order(DRAW_ROAD),
+            )?;
+        }
+        if !drawing.merge_section_centrelines.is_empty() {
+            let (lines, radii): (Vec<Vec<[f32; 2]>>, Vec<f32>) = drawing
+                .merge_section_centrelines
+                .iter()
+                .map(|(line, width)| (line.iter().map(to_2d).collect(), (0.5 * width) as f32))
+                .unzip();
+            active.stream.log_static(
+                "world/road/merge_section",
+                &LineStrips2D::new(lines)
+                    .with_colors([Color::from_unmultiplied_rgba(255, 140, 0, 50)])
+                    .with_radii(radii)
+                    .with_draw_order(DRAW_MERGE_SECTION),
+            )?;
+        }
+        if self.params.lane_ids {
+            active.stream.log_static(
+                "world/road/lane_ids",
+                &Points2D::new(drawing.lane_labels.iter().map(|l| to_2d(&l.at_m)))
+                    .with_labels(drawing.lane_labels.iter().map(|l| l.text.clone()))
+                    .with_colors([Color::from_rgb(200, 200, 255)])
+                    .with_radii([0.3_f32])
+                    .with_show_labels(true)
+                    .with_draw_order(DRAW_ROAD),
+            )?;
+        }
         // The frame's scale is the inverse of the view's: world lengths shrink by `scale`.
-        let (translation, scale) = overview_frame(road);
+        let (translation, scale) = overview_frame(drawing.bounds_m);
         active.stream.log_static(
             "world/overview",
             &Transform3D::from_translation_rotation_scale(
@@ -219,11 +255,30 @@ impl Recorder {
             .position(|n| *n == self.params.follow)
             .and_then(|i| bodies.get(i))
         {
+            // Turned to the heading of the vehicle's lane (the nearest lane of the logged road),
+            // so that the follow view turns along a curve: R = R_z(θ) · R_x(π) = (x, y, z, w)
+            // (cos θ/2, sin θ/2, 0, 0); θ = 0 on a straight road along X (the plain Y flip).
+            let heading_rad = active
+                .lanes
+                .as_ref()
+                .filter(|_| body.x_m.is_finite() && body.y_m.is_finite())
+                .map_or(0.0, |lanes| {
+                    let hit = lanes.nearest_lane([body.x_m, body.y_m]);
+                    lanes
+                        .lane(hit.lane)
+                        .map_or(0.0, |l| l.heading_rad(hit.frame.s_m))
+                });
+            let rotation = if heading_rad == 0.0 {
+                y_up_quaternion()
+            } else {
+                let (s, c) = (0.5 * heading_rad).sin_cos();
+                rerun::datatypes::Quaternion::from_xyzw([c as f32, s as f32, 0.0, 0.0])
+            };
             active.stream.log(
                 "world/follow",
                 &Transform3D::from_translation_rotation(
                     [body.x_m as f32, body.y_m as f32, 0.0],
-                    y_up_quaternion(),
+                    rotation,
                 ),
             )?;
         }
@@ -455,11 +510,17 @@ impl Recorder {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mergesim_types::MergeRoad;
+
+    fn bounds(road: &MergeRoad) -> [[f64; 2]; 2] {
+        let lanes = road.lane_road().unwrap_or_else(|e| panic!("{e}"));
+        crate::road_drawing::RoadDrawing::new(&lanes).bounds_m
+    }
 
     /// Where a world point appears in the whole-road view: scale · R⁻¹ (p − translation), R the
     /// Y flip.
     fn in_view(road: &MergeRoad, x_m: f64, y_m: f64) -> (f64, f64) {
-        let ([tx, ty, _], scale) = overview_frame(road);
+        let ([tx, ty, _], scale) = overview_frame(bounds(road));
         let s = f64::from(scale);
         (s * (x_m - f64::from(tx)), -s * (y_m - f64::from(ty)))
     }
@@ -481,9 +542,9 @@ mod tests {
             ..MergeRoad::default()
         };
         // A road up to 750 m long keeps 1 m = 1 m; a longer one is scaled down.
-        assert_eq!(overview_frame(&urgent).1, 1.0);
-        assert_eq!(overview_frame(&short).1, 1.0);
-        assert!((f64::from(overview_frame(&platoon).1) - 750.0 / 3050.0).abs() < 1e-6);
+        assert_eq!(overview_frame(bounds(&urgent)).1, 1.0);
+        assert_eq!(overview_frame(bounds(&short)).1, 1.0);
+        assert!((f64::from(overview_frame(bounds(&platoon)).1) - 750.0 / 3050.0).abs() < 1e-6);
         for road in [urgent, platoon, short] {
             for x_m in [
                 road.start_x_m,
@@ -500,6 +561,28 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// A road on a 300 m-radius curve (600 m along its divider: 2 rad) is scaled by its
+    /// height and every point of its edges appears within the view's fixed bounds.
+    #[test]
+    fn the_whole_road_view_shows_a_curved_road_whole() {
+        let spec = mergesim_types::lanes::curved_merge_spec(&MergeRoad::default(), 300.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let lanes = LaneRoad::new(&spec).unwrap_or_else(|e| panic!("{e}"));
+        let drawing = crate::road_drawing::RoadDrawing::new(&lanes);
+        let ([tx, ty, _], scale) = overview_frame(drawing.bounds_m);
+        assert!(scale < 1.0);
+        for p in drawing.outer_edges.iter().flatten() {
+            let s = f64::from(scale);
+            let (x, y) = (s * (p[0] - f64::from(tx)), -s * (p[1] - f64::from(ty)));
+            assert!(
+                (-10.0..=OVERVIEW_LENGTH_M + 10.0).contains(&x)
+                    && (-OVERVIEW_HALF_HEIGHT_M - 1e-3..=OVERVIEW_HALF_HEIGHT_M + 1e-3)
+                        .contains(&y),
+                "{p:?} appears at ({x}, {y})"
+            );
         }
     }
 }

@@ -15,9 +15,11 @@
 //!
 //! | entity | archetype | content |
 //! |---|---|---|
-//! | `world/road/edges` | `LineStrips2D` (static) | upper edge, piecewise lower edge (Eq. 3) |
-//! | `world/road/divider` | `LineStrips2D` (static) | lane divider up to the end of the merge |
-//! | `world/road/merge_section` | `Boxes2D` (static) | translucent box over the merge section |
+//! | `world/road/edges` | `LineStrips2D` (static) | the drivable area's outer edges, solid (any road of lanes, curved or not; on the merge road the upper edge and the piecewise lower edge of Eq. 3) |
+//! | `world/road/divider` | `LineStrips2D` (static) | the dividers between same-direction lanes, dashed (4 m dashes, 4 m gaps) |
+//! | `world/road/lane_ends` | `LineStrips2D` (static) | closed ends of lanes that end (a taper's tip has none); only if there are any |
+//! | `world/road/merge_section` | `LineStrips2D` (static) | translucent band along the tapering stretch of each lane that ends |
+//! | `world/road/lane_ids` | `Points2D` (static) | each lane's id at half its length (only with `RecorderParams::lane_ids`) |
 //! | `world/vehicles` | `Boxes2D` | one box (length × width, axis-aligned), label and colour per vehicle |
 //! | `world/paths/<name>/planned` (+ `_points`) | `LineStrips2D`, `Points2D` | planned path |
 //! | `world/paths/<name>/received` | `LineStrips2D` | shared local paths received over V2V |
@@ -36,8 +38,10 @@
 //! # Following a vehicle
 //! Rerun 0.36 has no follow camera and a view's visual bounds are a blueprint value, not a
 //! temporal one. The recording therefore logs, at every logged instant, the transform of
-//! `world/follow` (translation = the followed vehicle's position, rotation = 180° about X, which
-//! turns Y up on screen). The "Follow" view has `world/follow` as its origin, so Rerun draws
+//! `world/follow` (translation = the followed vehicle's position, rotation = the heading θ of
+//! its lane (the nearest lane of the road given to `log_road`) about Z, then 180° about X, which
+//! turns Y up on screen; θ = 0 on the straight merge road), so the follow view turns along a
+//! curve. The "Follow" view has `world/follow` as its origin, so Rerun draws
 //! everything under `world` in that frame: the followed vehicle stays at (0, 0) and the visual
 //! bounds ([`RecorderParams::follow_window_m`]) form a fixed window around it. The "Whole road"
 //! view has the static frame `world/overview` as its origin.
@@ -169,6 +173,8 @@ pub struct RecorderParams {
     /// recorded for every vehicle. Both grow with the number of vehicles (received paths with
     /// its square): with 50 vehicles they make a 72 s recording ~0.5 GB (1 GB in 3D).
     pub detail_vehicles: Option<usize>,
+    /// Write each lane's id on the road (`world/road/lane_ids`; `merge_sim run --lane-ids`).
+    pub lane_ids: bool,
 }
 
 /// Vehicles whose fields and received paths are recorded by default (every built-in scenario
@@ -195,6 +201,7 @@ impl Default for RecorderParams {
             road_line_radius_m: 0.08,
             path_line_radius_m: 0.06,
             detail_vehicles: Some(DEFAULT_DETAIL_VEHICLES),
+            lane_ids: false,
         }
     }
 }

@@ -197,6 +197,8 @@ pub(super) struct ActiveRecording {
     pub(super) styled_series: BTreeSet<String>,
     /// Colour of each vehicle name seen in `log_vehicles`.
     pub(super) name_colors: BTreeMap<String, Color>,
+    /// The road logged by `log_road`: the follow frame turns to the followed vehicle's lane.
+    pub(super) lanes: Option<mergesim_types::lanes::LaneRoad>,
 }
 
 impl Recorder {
@@ -241,6 +243,7 @@ impl Recorder {
                 final_path,
                 styled_series: BTreeSet::new(),
                 name_colors: BTreeMap::new(),
+                lanes: None,
             }),
         };
         recorder.log_field_legend()?;

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use mergesim_types::{MergeRoad, PathPoint, SharedLocalPath};
+use mergesim_types::{PathPoint, SharedLocalPath};
 
 use super::{EventLevel, Recorder, RecorderParams, RecordingError};
 use crate::body_state::BodyState;
@@ -39,7 +39,10 @@ impl Recorder {
     }
 
     /// No-op.
-    pub fn log_road(&mut self, _road: &MergeRoad) -> Result<(), RecordingError> {
+    pub fn log_road(
+        &mut self,
+        _lanes: &mergesim_types::lanes::LaneRoad,
+    ) -> Result<(), RecordingError> {
         Ok(())
     }
 

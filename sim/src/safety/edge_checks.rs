@@ -1,14 +1,57 @@
-//! Vehicle–road-edge checks of one body at one instant: contact with the upper edge and the
-//! piecewise lower edge (taper included), or lying entirely beyond it.
+//! Vehicle–road-edge checks of one body at one instant: contact with an outer edge of the
+//! drivable area (left/upper or right/lower, closed lane ends and the merge taper included),
+//! or lying entirely beyond it.
 
 use parry3d::math::{Pose, Vector};
 use parry3d::query;
 use parry3d::shape::Segment;
 
 use super::pair_checks::local_box;
-use super::{BodyState, EdgeContactEvent, EdgeState, RoadEdge, SafetyError, SafetyMonitor};
+use super::{
+    BodyState, EdgeChunk, EdgeContactEvent, EdgeState, RoadEdge, SafetyError, SafetyMonitor,
+};
+
+/// Distance from `p` to the axis-aligned box `[lo, hi]` (0 inside).
+fn box_distance_m(p: [f64; 2], lo: [f64; 2], hi: [f64; 2]) -> f64 {
+    let dx = (lo[0] - p[0]).max(p[0] - hi[0]).max(0.0);
+    let dy = (lo[1] - p[1]).max(p[1] - hi[1]).max(0.0);
+    dx.hypot(dy)
+}
 
 impl SafetyMonitor {
+    /// The edge piece nearest to `p` (index into `edges`), if the road has edges.
+    fn nearest_edge_segment(&self, p: [f64; 2]) -> Option<usize> {
+        let mut best: Option<(usize, f64)> = None;
+        for chunk in &self.edge_chunks {
+            let EdgeChunk { lo, hi, segments } = chunk;
+            if best.is_some_and(|(_, d)| box_distance_m(p, *lo, *hi) >= d) {
+                continue;
+            }
+            for k in segments.clone() {
+                let seg = &self.edges[k];
+                let d = point_segment_distance_m(p, seg.a, seg.b);
+                if best.is_none_or(|(_, bd)| d < bd) {
+                    best = Some((k, d));
+                }
+            }
+        }
+        best.map(|(k, _)| k)
+    }
+
+    /// True if `p` lies off the drivable area beyond the edge piece nearest to it (on the side
+    /// away from the road; beyond the road's open start or end it is not).
+    fn beyond_edge(&self, p: [f64; 2]) -> Option<RoadEdge> {
+        let seg = self.edges[self.nearest_edge_segment(p)?];
+        let cross =
+            (seg.b[0] - seg.a[0]) * (p[1] - seg.a[1]) - (seg.b[1] - seg.a[1]) * (p[0] - seg.a[0]);
+        // Upper (left-hand) pieces have the road on their right, lower ones on their left.
+        let outside = match seg.edge {
+            RoadEdge::Upper => cross > 0.0,
+            RoadEdge::Lower => cross < 0.0,
+        };
+        (outside && !self.lanes.is_drivable(p)).then_some(seg.edge)
+    }
+
     pub(super) fn check_edges(
         &mut self,
         t_s: f64,
@@ -18,18 +61,23 @@ impl SafetyMonitor {
         let radius_m = body.bounding_radius_m();
         let (pose, cuboid) = local_box(body, body.x_m, body.y_m);
         let z_mid = (0.5 * body.height_m) as f32;
+        let centre = [body.x_m, body.y_m];
+        // Entirely beyond an edge: the centre is off the road, beyond its nearest edge piece.
+        let beyond = self.beyond_edge(centre);
         for edge in [RoadEdge::Upper, RoadEdge::Lower] {
-            // Entirely beyond the edge: the centre is off the road (and no segment touches).
-            let mut contact = match edge {
-                RoadEdge::Upper => body.y_m > self.road.y_upper_m(),
-                RoadEdge::Lower => body.y_m < self.road.lower_edge_y_m(body.x_m),
-            };
-            for segment in self.edges.iter().filter(|s| s.edge == edge) {
+            let mut contact = beyond == Some(edge);
+            let near_chunks = self
+                .edge_chunks
+                .iter()
+                .filter(|c| box_distance_m(centre, c.lo, c.hi) <= radius_m);
+            for k in near_chunks.flat_map(|c| c.segments.clone()) {
+                let segment = self.edges[k];
                 if contact {
                     break;
                 }
-                let centre = [body.x_m, body.y_m];
-                if point_segment_distance_m(centre, segment.a, segment.b) > radius_m {
+                if segment.edge != edge
+                    || point_segment_distance_m(centre, segment.a, segment.b) > radius_m
+                {
                     continue;
                 }
                 // Only the part of the edge within the bounding circle's reach can touch the

@@ -4,13 +4,15 @@
 use mergesim_types::VehicleId;
 use serde::{Deserialize, Serialize};
 
-/// Which road edge.
+/// Which road edge: the drivable area's outer edges seen in the direction of travel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RoadEdge {
-    /// The straight upper (left) edge, Y = Y_u.
+    /// A left-hand outer edge (the road on its right); on the merge road the straight upper
+    /// edge, Y = Y_u.
     Upper,
-    /// The piecewise lower (right) edge of Eq. 3, including the merge taper.
+    /// A right-hand outer edge (the road on its left), closed lane ends included; on the merge
+    /// road the piecewise lower edge of Eq. 3, including the merge taper.
     Lower,
 }
 

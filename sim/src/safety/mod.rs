@@ -5,9 +5,12 @@
 //! - **collision**: exact intersection of two vehicles' oriented boxes (parry's SAT for
 //!   cuboids); one [`CollisionEvent`] per pair and *contact episode* (a pair that stays in
 //!   contact over many instants counts once; separating and touching again counts again);
-//! - **road-edge contact**: a box touching an edge of [`MergeRoad`] (the straight upper edge and
-//!   the piecewise lower edge of Eq. 3, taper included) or lying entirely beyond it; one
-//!   [`EdgeContactEvent`] per vehicle, edge and episode;
+//! - **road-edge contact**: a box touching an outer edge of the road's drivable area
+//!   ([`LaneRoad::outer_edges`]: on the merge road the straight upper edge and the piecewise
+//!   lower edge of Eq. 3, taper included; on any road of lanes, curved or not, the left and
+//!   right outer edges and the closed lane ends) or lying entirely beyond it; one
+//!   [`EdgeContactEvent`] per vehicle, edge ([`RoadEdge`]: left/upper or right/lower) and
+//!   episode;
 //! - **gap**: exact distance between two boxes (GJK), minimum over the run and per pair;
 //! - **TTC** (time to collision): the time until two boxes touch if both keep their current
 //!   world-frame velocity and heading — a parry shape cast of the boxes
@@ -68,7 +71,11 @@ mod params;
 
 use std::collections::BTreeMap;
 
-use mergesim_types::{MergeRoad, VehicleId};
+use std::sync::Arc;
+
+use mergesim_types::VehicleId;
+use mergesim_types::lanes::LaneRoad;
+use vehicles::road_collider::{RoadSide, road_side_of};
 
 use crate::spatial::XSweep;
 
@@ -97,6 +104,62 @@ struct EdgeSegment {
     b: [f64; 2],
 }
 
+/// Consecutive edge pieces under one bounding box, so that a body far from most of a long
+/// (curved, finely sampled) edge skips them at once.
+#[derive(Clone, Debug)]
+struct EdgeChunk {
+    lo: [f64; 2],
+    hi: [f64; 2],
+    segments: std::ops::Range<usize>,
+}
+
+/// Pieces per [`EdgeChunk`].
+const EDGE_CHUNK: usize = 16;
+
+/// The edge pieces of `lanes`' outer edges, each tagged with its side: a piece with the road on
+/// its right is a left-hand (upper) edge, one with the road on its left a right-hand (lower)
+/// edge or a closed lane end. Pieces whose side cannot be told (degenerate) are left out.
+fn edge_segments(lanes: &LaneRoad) -> (Vec<EdgeSegment>, Vec<EdgeChunk>) {
+    let mut edges = Vec::new();
+    let mut chunks = Vec::new();
+    for outer in lanes.outer_edges() {
+        let start = edges.len();
+        for w in outer.polyline_m.windows(2) {
+            let edge = match road_side_of(lanes, w[0], w[1]) {
+                Some(RoadSide::Right) => RoadEdge::Upper,
+                Some(RoadSide::Left) => RoadEdge::Lower,
+                None => continue,
+            };
+            edges.push(EdgeSegment {
+                edge,
+                a: w[0],
+                b: w[1],
+            });
+        }
+        let mut k = start;
+        while k < edges.len() {
+            let end = (k + EDGE_CHUNK).min(edges.len());
+            let mut lo = [f64::INFINITY; 2];
+            let mut hi = [f64::NEG_INFINITY; 2];
+            for seg in &edges[k..end] {
+                for p in [seg.a, seg.b] {
+                    for i in 0..2 {
+                        lo[i] = lo[i].min(p[i]);
+                        hi[i] = hi[i].max(p[i]);
+                    }
+                }
+            }
+            chunks.push(EdgeChunk {
+                lo,
+                hi,
+                segments: k..end,
+            });
+            k = end;
+        }
+    }
+    (edges, chunks)
+}
+
 #[derive(Clone, Copy, Debug)]
 struct PairState {
     /// Check time at which the pair was last visited.
@@ -121,8 +184,9 @@ struct EdgeState {
 #[derive(Clone, Debug)]
 pub struct SafetyMonitor {
     params: SafetyParams,
-    road: MergeRoad,
+    lanes: Arc<LaneRoad>,
     edges: Vec<EdgeSegment>,
+    edge_chunks: Vec<EdgeChunk>,
     pairs: BTreeMap<(VehicleId, VehicleId), PairState>,
     edge_states: BTreeMap<(VehicleId, RoadEdge), EdgeState>,
     collisions: Vec<CollisionEvent>,
@@ -136,27 +200,16 @@ pub struct SafetyMonitor {
 }
 
 impl SafetyMonitor {
-    /// A monitor for `road` with `params` (both validated).
-    pub fn new(params: SafetyParams, road: &MergeRoad) -> Result<Self, SafetyError> {
+    /// A monitor for the road `lanes` with `params` (validated). The road-edge checks use the
+    /// drivable area's outer edges ([`LaneRoad::outer_edges`]).
+    pub fn new(params: SafetyParams, lanes: Arc<LaneRoad>) -> Result<Self, SafetyError> {
         params.validate()?;
-        road.validate()?;
-        let mut edges = Vec::new();
-        for (edge, polyline) in [
-            (RoadEdge::Upper, road.upper_edge_polyline()),
-            (RoadEdge::Lower, road.lower_edge_polyline()),
-        ] {
-            for w in polyline.windows(2) {
-                edges.push(EdgeSegment {
-                    edge,
-                    a: w[0],
-                    b: w[1],
-                });
-            }
-        }
+        let (edges, edge_chunks) = edge_segments(&lanes);
         Ok(Self {
             params,
-            road: road.clone(),
+            lanes,
             edges,
+            edge_chunks,
             pairs: BTreeMap::new(),
             edge_states: BTreeMap::new(),
             collisions: Vec::new(),

@@ -119,6 +119,10 @@ pub(crate) struct RunArgs {
     /// follow].
     #[arg(long, value_name = "VIEW", value_enum, requires = "gif")]
     pub(crate) gif_view: Option<GifViewArg>,
+    /// Write each lane's id on the road ("lane 1", at half the lane's length) in the
+    /// recording (`world/road/lane_ids`) and the GIF.
+    #[arg(long)]
+    pub(crate) lane_ids: bool,
     /// Write the JSON summary here.
     #[arg(long, value_name = "PATH")]
     pub(crate) json: Option<PathBuf>,
@@ -194,6 +198,9 @@ pub(crate) struct CompareArgs {
     /// planner; states_obstacle.png is the paper's Fig. 4) and time_series.csv (their data).
     #[arg(long, value_name = "DIR")]
     pub(crate) plots: Option<PathBuf>,
+    /// Write each lane's id on the road of paths.png ("lane 1", at half the lane's length).
+    #[arg(long, requires = "plots")]
+    pub(crate) lane_ids: bool,
 }
 
 #[derive(Copy, Clone, Debug, ValueEnum)]

@@ -102,6 +102,7 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
             || mergesim::animation::GifView::default_for(scenario.vehicles.len()),
             Into::into,
         ),
+        lane_ids: args.lane_ids,
         ..mergesim::animation::GifParams::default()
     };
     if args.gif.is_some() {
@@ -146,6 +147,7 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
         profile: args.profile,
         record_detail: args.record_detail.0,
         follow: Some(&follow),
+        lane_ids: args.lane_ids,
     };
     let mut finished = simulate(&scenario, &what, interrupt)?;
     finished.summary = finished.summary.with_drawn(&scenario);
@@ -264,9 +266,11 @@ fn write_run_gif(
             }
         }
     };
+    // The road as lanes (the world's own road: `World` builds its lanes the same way).
+    let lanes = instance.sim.road.lane_road().map_err(input)?;
     let stats = write_gif(
         path,
-        &instance.sim.road,
+        &lanes,
         &vehicles,
         &finished.outcome.time_series,
         &finished.outcome.safety.collisions,
@@ -345,10 +349,17 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
                 collisions,
             })
             .collect();
-        let road = &scenario.instance(args.seed).sim.road;
+        // The road as lanes, as the world builds it from the scenario's road.
+        let lanes = scenario
+            .instance(args.seed)
+            .sim
+            .road
+            .lane_road()
+            .map_err(input)?;
         let written = mergesim::plots::write_comparison(
             dir,
-            road,
+            &lanes,
+            args.lane_ids,
             &series,
             mergesim::plots::FigureSize::default(),
             &caption,

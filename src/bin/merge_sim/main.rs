@@ -155,6 +155,8 @@ pub(crate) struct Simulation<'a> {
     pub(crate) record_detail: Option<usize>,
     /// The vehicle the recording's follow view follows (None: the default, `ego`).
     pub(crate) follow: Option<&'a str>,
+    /// Write the lanes' ids in the recording.
+    pub(crate) lane_ids: bool,
 }
 
 /// Runs one instance of `scenario` (the library's `run_instance`), with a progress line on a
@@ -173,6 +175,7 @@ pub(crate) fn simulate(
         profile,
         record_detail,
         follow,
+        lane_ids,
     } = *what;
     let planner = planner.map(|k| k.name().to_string());
     let label = planner_label(scenario, planner.as_deref());
@@ -183,6 +186,7 @@ pub(crate) fn simulate(
             RecorderParams {
                 detail_vehicles: record_detail,
                 follow: follow.map_or_else(|| RecorderParams::default().follow, str::to_string),
+                lane_ids,
                 ..RecorderParams::default()
             },
         )
