@@ -15,6 +15,7 @@ pub mod field_params;
 pub mod following;
 pub mod lane_frame;
 mod lane_road_edges;
+mod lane_road_frames;
 pub mod lane_road_field;
 pub mod local_path;
 pub mod min_distance;

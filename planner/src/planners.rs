@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 use crate::cubic_fit::{FitMethod, fit_path_cubic};
 use crate::error::PlannerError;
 use crate::fallback::{FallbackInput, fallback_plan};
-use crate::following::{V2vLossFallback, following_cap_mps};
+use crate::following::{V2vLossFallback, following_cap_in_lane_frame_mps};
 use crate::local_path::local_path_adaptive;
 use crate::others::{
     RoleRules, arc_length_term, fixed_waypoint_term, gather_others, has_fresh_shared_path,
@@ -32,7 +32,9 @@ use crate::params::{PlannerParams, SlpReading};
 use crate::polyline::Polyline;
 use crate::potential_field::{GridSpec, PotentialField};
 pub use crate::request::{PlanRequest, validate_request};
-use crate::road::MergeRoad;
+use crate::lane_road_field::LaneRoadGeometry;
+use mergesim_types::lanes::LaneRoad;
+use std::sync::Arc;
 use crate::speed_optimisation::{
     Aggregate, SpeedOptimiser, SpeedProblem, SpeedTerm, friction_speed_limits,
 };
@@ -127,7 +129,8 @@ pub struct PlanStats {
 pub struct PfPlanner {
     kind: PlannerKind,
     params: PlannerParams,
-    road: MergeRoad,
+    /// The road as lanes, prepared once (`lane_road_field.rs`), shareable between planners.
+    road: Arc<LaneRoadGeometry>,
     last_good: Option<Plan>,
     optimiser: SpeedOptimiser,
     stats: PlanStats,
@@ -155,14 +158,29 @@ struct CycleFailure {
 }
 
 impl PfPlanner {
-    /// A planner of `kind`; fails if the parameters or the road are invalid.
+    /// A planner of `kind` on the road `lanes` (a [`LaneRoad`], or one shared through an
+    /// `Arc`: the simulator passes the road its observations carry, `Observation::lanes`);
+    /// its geometry is prepared here, once. Fails if the parameters are invalid (a
+    /// [`LaneRoad`] is valid once built).
     pub fn new(
         kind: PlannerKind,
         params: PlannerParams,
-        road: MergeRoad,
+        lanes: impl Into<Arc<LaneRoad>>,
+    ) -> Result<Self, PlannerError> {
+        Self::on_geometry(
+            kind,
+            params,
+            Arc::new(LaneRoadGeometry::shared(lanes.into())),
+        )
+    }
+
+    /// A planner of `kind` on a road already prepared (several planners can share one).
+    pub fn on_geometry(
+        kind: PlannerKind,
+        params: PlannerParams,
+        road: Arc<LaneRoadGeometry>,
     ) -> Result<Self, PlannerError> {
         params.validate()?;
-        road.validate()?;
         Ok(Self {
             kind,
             params,
@@ -184,8 +202,18 @@ impl PfPlanner {
         &self.params
     }
 
-    /// The road.
-    pub fn road(&self) -> &MergeRoad {
+    /// The road, as lanes.
+    pub fn road(&self) -> &LaneRoad {
+        self.road.road()
+    }
+
+    /// The road, shared (to build another planner on it).
+    pub fn shared_road(&self) -> Arc<LaneRoad> {
+        self.road.shared_road().clone()
+    }
+
+    /// The road's prepared geometry, shared (to build another planner on it).
+    pub fn road_geometry(&self) -> &Arc<LaneRoadGeometry> {
         &self.road
     }
 
@@ -300,6 +328,7 @@ impl PfPlanner {
                 req,
                 &others,
                 line,
+                &self.road,
             ))
         } else {
             let rules = RoleRules {
@@ -317,9 +346,12 @@ impl PfPlanner {
                     req,
                     &others,
                     line,
+                    &self.road,
                 )),
                 SlpReading::FixedWaypoints => {
-                    Box::new(fixed_waypoint_term(params, rules, req, &others, waypoints))
+                    Box::new(fixed_waypoint_term(
+                        params, rules, req, &others, waypoints, &self.road,
+                    ))
                 }
             }
         };
@@ -422,8 +454,9 @@ impl PfPlanner {
                     }
                 }
                 if degraded
-                    && let Some(cap_mps) = following_cap_mps(
+                    && let Some(cap_mps) = following_cap_in_lane_frame_mps(
                         params,
+                        &self.road,
                         req.ego_id,
                         &req.ego,
                         &req.ego_shape,

@@ -40,8 +40,13 @@ pub fn behaviour_of(
     spec: &VehicleSpec,
     registry: &BehaviourRegistry,
     planner_override: Option<&str>,
+    lanes: &std::sync::Arc<mergesim_types::lanes::LaneRoad>,
 ) -> Result<Box<dyn Behaviour>, SimError> {
-    let input = FactoryInput { config, spec };
+    let input = FactoryInput {
+        config,
+        spec,
+        lanes,
+    };
     Ok(match &spec.driver {
         Driver::Planner(name) => registry.create(planner_override.unwrap_or(name), &input)?,
         Driver::Prescribed {
@@ -72,12 +77,13 @@ impl Agent {
         spec: &VehicleSpec,
         registry: &BehaviourRegistry,
         planner_override: Option<&str>,
+        lanes: &std::sync::Arc<mergesim_types::lanes::LaneRoad>,
     ) -> Result<Self, SimError> {
         let params = VehicleParams::preset(&spec.preset)?;
         let y_m = config.road.lane_center_y_m(spec.lane) + spec.y_offset_m;
         let vehicle = Vehicle::spawn(physics, &params, spec.x_m, y_m, 0.0, spec.speed_mps)?;
         let shape = vehicle.shape(VehicleShape::default().max_brake_decel_mps2);
-        let behaviour = behaviour_of(config, spec, registry, planner_override)?;
+        let behaviour = behaviour_of(config, spec, registry, planner_override, lanes)?;
         let tracker = Tracker::new(config.tracker.clone(), &params);
         Ok(Self {
             id: index as VehicleId,

@@ -116,6 +116,7 @@ impl World {
                 spec,
                 registry,
                 options.planner_override.as_deref(),
+                &lanes,
             )?);
         }
         let bus = V2vBus::new(
