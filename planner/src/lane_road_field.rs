@@ -1,14 +1,15 @@
 //! The road terms of the potential field (paper Eqs. 1–3) on a road made of lanes
-//! ([`LaneRoad`]), with their world gradients for Eq. 7. Not yet used by the planners (they run
-//! on [`MergeRoad`](crate::road::MergeRoad) through `road_field.rs` and `attractive_field.rs`);
-//! on the straight merge road both give the same values (tests in
+//! ([`LaneRoad`]), with their world gradients for Eq. 7: what the planners step in. On the
+//! straight merge road they give today's straight-road field (`road_field.rs`,
+//! `attractive_field.rs`, kept as the reference of the tests in
 //! `planner/tests/lane_road_field.rs`). The formulas are in planner/README.md, "The road terms
 //! in the lane frame".
 //!
-//! - **Eq. 1** ([`LaneAttraction`]): U_AT = ½ λ (s − s_tar)², s along the target lane's
-//!   centreline, the target at (s_tar, d = 0) with s_tar = s_ego + look-ahead. Like the straight
-//!   road's ½ λ (X − X_tar)² it measures only the distance along the road (no lateral spring:
-//!   lateral placement is the divider's and the edges' job). The moving target's pull is
+//! - **Eq. 1** ([`LaneAttraction`], and through the prepared frames
+//!   `PotentialField::moving_target_gradient`): U_AT = ½ λ (s − s_tar)², s along the target
+//!   lane's centreline ([`LaneRoadGeometry::target_lane`]: never a lane that ends), the target
+//!   at (s_tar, d = 0) with s_tar = s_ego + look-ahead. Like the straight road's
+//!   ½ λ (X − X_tar)² it measures only the distance along the road. The moving target's pull is
 //!   −λ·look-ahead·∇s.
 //! - **Eq. 2**: for each divider between same-direction lanes ([`LaneRoad::dividers`]), in the
 //!   frame of the lane whose bound it is, U_LD = A exp(−(d − d_div(s))² / 2σ²) where the divider
@@ -17,8 +18,15 @@
 //!   lane end included), e(g) with the clearance g = δ − l_w/2, δ the signed Euclidean distance
 //!   to the edge (positive on the road), e the straight road's ½ ξ/g² with its linear
 //!   continuation below g_c (`road_field.rs`).
+//! - **Lane-end rule**: a vehicle in a lane that goes on sees the divider towards a neighbour
+//!   that ends as Eq. 3's edge, cut off at [`LANE_END_WALL_CUTOFF_M`] ([`wall_term`],
+//!   [`LaneRoadGeometry::lane_end_walls`]).
 //! - **Eq. 7**: ∇U = ∂U/∂s ∇s + ∂U/∂d ∇d (`lane_frame.rs`); the edge term's gradient is the
 //!   distance's own, e'(g)·∇δ.
+//!
+//! Cost: straight lanes are projected in O(1) and constant bounds need no interpolation
+//! (`lane_road_frames.rs`); an edge that is one straight line is one dot product, an edge of a
+//! few segments is searched without its bounding boxes (`lane_road_edges.rs`).
 
 use std::sync::Arc;
 
@@ -47,11 +55,6 @@ struct DividerGeometry {
     right_lane: usize,
 }
 
-/// How far a vehicle may head away from a divider (rad, relative to its lane) and still see it
-/// as a wall under the lane-end rule: a vehicle heading away faster is leaving it behind
-/// (a merge in progress), and a wall appearing right beside it would only jolt its path.
-pub const LANE_END_WALL_AWAY_HEADING_RAD: f64 = 0.01;
-
 /// The lane-end rule's wall acts only at body clearances below this (m): beyond it its term is
 /// zero, so a vehicle near its lane's centre (clearance (w − l_w)/2 = 0.945 m for a 1.61 m car
 /// in a 3.5 m lane) sees the same field as without the rule, and only a path pushed towards
@@ -61,7 +64,7 @@ pub const LANE_END_WALL_CUTOFF_M: f64 = 0.5;
 /// The lane-end wall's term at body clearance g and its slope: Eq. 3's e(g) (with its linear
 /// continuation below g_c) less its tangent at the cut-off g_w = [`LANE_END_WALL_CUTOFF_M`],
 /// zero beyond g_w: e(g) − e(g_w) − e'(g_w)(g − g_w), C¹ at g_w.
-pub(crate) fn wall_term(gain_m2: f64, clamp_m: f64, clearance_m: f64) -> (f64, f64) {
+pub fn wall_term(gain_m2: f64, clamp_m: f64, clearance_m: f64) -> (f64, f64) {
     let cut = LANE_END_WALL_CUTOFF_M;
     if clearance_m >= cut {
         return (0.0, 0.0);
@@ -285,21 +288,29 @@ impl LaneRoadGeometry {
     }
 
     /// The dividers that a vehicle in `state` (half-width `half_width_m`) sees as walls under
-    /// the lane-end rule, with the sign that makes δ = sign·(d − d_div) positive on its side:
-    /// the dividers between its lane, if that goes on, and a neighbour that ends ahead — while
-    /// its body is wholly inside its lane there and it is not heading away from the divider by
-    /// more than [`LANE_END_WALL_AWAY_HEADING_RAD`] (a merge in progress).
-    pub fn lane_end_walls(&self, state: &VehicleState, half_width_m: f64) -> Vec<(usize, f64)> {
+    /// the lane-end rule, with the sign that makes δ = sign·(d − d_div) positive on its side,
+    /// and the lane it is settled in (to pass back on its next cycle as `settled_lane`).
+    ///
+    /// The walls are the dividers between its lane, if that goes on, and a neighbour that ends
+    /// ahead. They apply once the vehicle is *settled* in its lane: its body's clearance to each
+    /// of them at least [`LANE_END_WALL_CUTOFF_M`] now (where the wall's term is zero, so it
+    /// appears without a jolt: a vehicle that has just merged meets no wall pushing at it), or
+    /// settled at its previous cycle in the same lane (`settled_lane`, the lane index) — then
+    /// they stay while its centre is in that lane, however close a push brings it.
+    pub fn lane_end_walls(
+        &self,
+        state: &VehicleState,
+        half_width_m: f64,
+        settled_lane: Option<usize>,
+    ) -> (Vec<(usize, f64)>, Option<usize>) {
         let p = [state.x_m, state.y_m];
         let lane = self.lane_index_at(p);
         if self.lane_ends(lane) {
-            return Vec::new();
+            return (Vec::new(), None);
         }
         let lanes = self.road.lanes();
-        let own_s = self.frames[lane].project(lanes[lane].centreline(), p).s_m;
-        let relative_heading =
-            crate::lane_frame::wrap_rad(state.yaw_rad - self.lane_heading_rad(lane, own_s));
         let mut walls = Vec::new();
+        let mut clear = true;
         for (k, dg) in self.dividers.iter().enumerate() {
             let (sign, other) = if dg.left_lane == lane {
                 (1.0, dg.right_lane)
@@ -318,13 +329,17 @@ impl LaneRoadGeometry {
             }
             let (d_div, _) = dg.offset.at(l, dg.side, s.s_m);
             let clearance = sign * (s.d_m - d_div) - half_width_m;
-            // Heading away from the divider: to the left if the vehicle's lane is its left.
-            let away_rad = sign * relative_heading;
-            if clearance >= 0.0 && away_rad <= LANE_END_WALL_AWAY_HEADING_RAD {
-                walls.push((k, sign));
-            }
+            clear &= clearance >= LANE_END_WALL_CUTOFF_M;
+            walls.push((k, sign));
         }
-        walls
+        if walls.is_empty() {
+            return (walls, None);
+        }
+        if settled_lane == Some(lane) || clear {
+            (walls, Some(lane))
+        } else {
+            (Vec::new(), None)
+        }
     }
 }
 
@@ -364,7 +379,8 @@ impl<'g> LaneRoadField<'g> {
     }
 
     /// The field of a vehicle in `state`, with the lane-end rule's walls
-    /// ([`LaneRoadGeometry::lane_end_walls`]): Eq. 3's edge term along each, in d − d_div(s).
+    /// ([`LaneRoadGeometry::lane_end_walls`] without a previous cycle: walls only if the vehicle
+    /// is settled now): [`wall_term`] along each, in d − d_div(s).
     pub fn for_vehicle(
         geometry: &'g LaneRoadGeometry,
         params: &PlannerParams,
@@ -372,7 +388,7 @@ impl<'g> LaneRoadField<'g> {
         state: &VehicleState,
     ) -> Self {
         Self {
-            walls: geometry.lane_end_walls(state, half_width_m),
+            walls: geometry.lane_end_walls(state, half_width_m, None).0,
             ..Self::new(geometry, params, half_width_m)
         }
     }

@@ -134,6 +134,9 @@ pub struct PfPlanner {
     last_good: Option<Plan>,
     optimiser: SpeedOptimiser,
     stats: PlanStats,
+    /// The lane (index) the vehicle was settled in at its last cycle, for the lane-end rule's
+    /// walls (`LaneRoadGeometry::lane_end_walls`).
+    settled_lane: Option<usize>,
     /// Time of the first planning cycle (s): V2V counts as lost only once a shared path could
     /// have arrived (`max_shared_path_age_s` after it).
     first_plan_s: Option<f64>,
@@ -185,6 +188,7 @@ impl PfPlanner {
             kind,
             params,
             road,
+            settled_lane: None,
             last_good: None,
             optimiser: SpeedOptimiser::new(),
             stats: PlanStats::default(),
@@ -228,15 +232,21 @@ impl PfPlanner {
     }
 
     /// The universal field of the request's ego (Eq. 5).
+    /// The lane-end rule's walls are those of the last cycle's settled lane.
     pub fn field<'s>(&'s self, req: &PlanRequest<'_>) -> PotentialField<'s> {
-        PotentialField::new(
+        let mut field = PotentialField::new(
             &self.params,
             &self.road,
             req.ego_id,
             &req.ego,
             &req.ego_shape,
             req.neighbours,
-        )
+        );
+        field.road.walls = self
+            .road
+            .lane_end_walls(&req.ego, 0.5 * req.ego_shape.width_m, self.settled_lane)
+            .0;
+        field
     }
 
     /// Universal potential U at (x, y) seen by the ego of `req` (for drawing the field). It
@@ -359,6 +369,11 @@ impl PfPlanner {
     }
 
     fn plan_cycle(&mut self, req: &PlanRequest<'_>) -> Result<Plan, CycleFailure> {
+        // The lane-end rule's walls: settled in a lane that goes on, now or at the last cycle.
+        let (walls, settled_lane) =
+            self.road
+                .lane_end_walls(&req.ego, 0.5 * req.ego_shape.width_m, self.settled_lane);
+        self.settled_lane = settled_lane;
         let params = &self.params;
         let n = params.waypoint_count;
         let fail = |error: PlannerError, waypoints: Option<Vec<[f64; 2]>>| CycleFailure {
@@ -367,7 +382,7 @@ impl PfPlanner {
         };
 
         // Eqs. 1–7: waypoints by gradient steps.
-        let field = PotentialField::new(
+        let mut field = PotentialField::new(
             params,
             &self.road,
             req.ego_id,
@@ -375,6 +390,7 @@ impl PfPlanner {
             &req.ego_shape,
             req.neighbours,
         );
+        field.road.walls = walls;
         let step_m = params.step_length_m(req.ego.speed_mps);
         let time_per_step_s = if params.predict_obstacles_in_path {
             params.step_time_s
