@@ -68,7 +68,10 @@ fn bench(c: &mut Criterion) {
             for q in black_box(&pts) {
                 let g = field.gradient(q[0], q[1]);
                 let j = geometry.jacobian(through, *q);
-                let a = [-gain * lookahead * j.grad_s[0], -gain * lookahead * j.grad_s[1]];
+                let a = [
+                    -gain * lookahead * j.grad_s[0],
+                    -gain * lookahead * j.grad_s[1],
+                ];
                 acc[0] += g[0] + a[0];
                 acc[1] += g[1] + a[1];
             }
@@ -88,7 +91,10 @@ fn bench(c: &mut Criterion) {
             for q in black_box(&curved_pts) {
                 let g = curved_field.gradient(q[0], q[1]);
                 let j = curved_geometry.jacobian(through, *q);
-                let a = [-gain * lookahead * j.grad_s[0], -gain * lookahead * j.grad_s[1]];
+                let a = [
+                    -gain * lookahead * j.grad_s[0],
+                    -gain * lookahead * j.grad_s[1],
+                ];
                 acc[0] += g[0] + a[0];
                 acc[1] += g[1] + a[1];
             }

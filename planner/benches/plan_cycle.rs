@@ -29,8 +29,12 @@ fn plan_cycle(c: &mut Criterion) {
         speed_mps: 15.0,
     };
     // The neighbour's SLP: its own PF-ISO plan at the same instant.
-    let mut other_planner =
-        PfPlanner::new(PlannerKind::PfIso, params.clone(), road.lane_road().expect("valid road")).expect("valid");
+    let mut other_planner = PfPlanner::new(
+        PlannerKind::PfIso,
+        params.clone(),
+        road.lane_road().expect("valid road"),
+    )
+    .expect("valid");
     let ego_as_neighbour = [Neighbour {
         id: 0,
         state: ego,
@@ -64,7 +68,12 @@ fn plan_cycle(c: &mut Criterion) {
         neighbours: &neighbours,
         shared_paths: &shared,
     };
-    let mut planner = PfPlanner::new(PlannerKind::PfIso, params, road.lane_road().expect("valid road")).expect("valid");
+    let mut planner = PfPlanner::new(
+        PlannerKind::PfIso,
+        params,
+        road.lane_road().expect("valid road"),
+    )
+    .expect("valid");
     let plan = planner.plan(&request).expect("valid request");
     assert!(plan.fallback.is_none());
     let stats = planner.last_stats();

@@ -180,12 +180,8 @@ impl EdgeGeometry {
                         }
                     })
                     .collect();
-                let line = (nseg == 1 && ray_start && ray_end).then(|| {
-                    (
-                        pts[0],
-                        [-inside_sign * dir[0][1], inside_sign * dir[0][0]],
-                    )
-                });
+                let line = (nseg == 1 && ray_start && ray_end)
+                    .then(|| (pts[0], [-inside_sign * dir[0][1], inside_sign * dir[0][0]]));
                 Some(Self {
                     dir,
                     ray_start,

@@ -209,9 +209,8 @@ impl LaneRoadGeometry {
         for (i, l) in self.road.lanes().iter().enumerate() {
             let fp = self.frames[i].project(l.centreline(), p_m);
             let excess = l.frame_excess_m(fp);
-            let better = best.is_none_or(|(_, b, e)| {
-                excess < e || (excess == e && fp.d_m.abs() < b.d_m.abs())
-            });
+            let better = best
+                .is_none_or(|(_, b, e)| excess < e || (excess == e && fp.d_m.abs() < b.d_m.abs()));
             if better {
                 best = Some((i, fp, excess));
             }
@@ -324,7 +323,7 @@ impl LaneRoadGeometry {
             }
             let l = &lanes[dg.lane];
             let s = self.frames[dg.lane].project(l.centreline(), p);
-            if !(s.s_m < dg.s_range_m[1]) {
+            if s.s_m.is_nan() || s.s_m >= dg.s_range_m[1] {
                 continue;
             }
             let (d_div, _) = dg.offset.at(l, dg.side, s.s_m);

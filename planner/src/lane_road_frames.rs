@@ -40,7 +40,7 @@ impl FastFrame {
         };
         let e = [b[0] - a[0], b[1] - a[1]];
         let len = e[0].hypot(e[1]);
-        if !(len > 0.0) {
+        if len.is_nan() || len <= 0.0 {
             return Self::General;
         }
         let t = [e[0] / len, e[1] / len];

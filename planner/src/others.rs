@@ -19,13 +19,13 @@
 
 use std::collections::BTreeMap;
 
+use crate::lane_road_field::LaneRoadGeometry;
+use crate::obstacle_field::HeadingForm;
 use crate::obstacle_field::{ObstacleField, ObstacleFieldParams, Role, SelfView};
 use crate::params::PlannerParams;
 use crate::planners::PlanRequest;
 use crate::polyline::Polyline;
 use crate::prediction::{PredictionModel, Trajectory};
-use crate::lane_road_field::LaneRoadGeometry;
-use crate::obstacle_field::HeadingForm;
 use crate::speed_optimisation::fixed_waypoint_term::SlotOther;
 use crate::speed_optimisation::{Aggregate, FixedWaypointTerm, InteractionTerm};
 use crate::types::{SharedLocalPath, VehicleId, VehicleShape};
@@ -198,6 +198,7 @@ fn slot_time_s(params: &PlannerParams, req: &PlanRequest<'_>, i: usize) -> f64 {
 
 /// The arc-length term (module doc of `speed_optimisation::interaction_term`): the others'
 /// fields at their poses at each slot time, against the ego's position along `line`.
+#[allow(clippy::too_many_arguments)] // the term's inputs, each used once
 pub fn arc_length_term(
     params: &PlannerParams,
     field_params: &ObstacleFieldParams,

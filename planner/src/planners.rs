@@ -24,6 +24,7 @@ use crate::cubic_fit::{FitMethod, fit_path_cubic};
 use crate::error::PlannerError;
 use crate::fallback::{FallbackInput, fallback_plan};
 use crate::following::{V2vLossFallback, following_cap_in_lane_frame_mps};
+use crate::lane_road_field::LaneRoadGeometry;
 use crate::local_path::local_path_adaptive;
 use crate::others::{
     RoleRules, arc_length_term, fixed_waypoint_term, gather_others, has_fresh_shared_path,
@@ -32,13 +33,12 @@ use crate::params::{PlannerParams, SlpReading};
 use crate::polyline::Polyline;
 use crate::potential_field::{GridSpec, PotentialField};
 pub use crate::request::{PlanRequest, validate_request};
-use crate::lane_road_field::LaneRoadGeometry;
-use mergesim_types::lanes::LaneRoad;
-use std::sync::Arc;
 use crate::speed_optimisation::{
     Aggregate, SpeedOptimiser, SpeedProblem, SpeedTerm, friction_speed_limits,
 };
 use crate::types::{FallbackReason, PathPoint, Plan, SharedLocalPath};
+use mergesim_types::lanes::LaneRoad;
+use std::sync::Arc;
 
 /// Which planner a vehicle runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -358,11 +358,9 @@ impl PfPlanner {
                     line,
                     &self.road,
                 )),
-                SlpReading::FixedWaypoints => {
-                    Box::new(fixed_waypoint_term(
-                        params, rules, req, &others, waypoints, &self.road,
-                    ))
-                }
+                SlpReading::FixedWaypoints => Box::new(fixed_waypoint_term(
+                    params, rules, req, &others, waypoints, &self.road,
+                )),
             }
         };
         (Some(term), weight, count)

@@ -28,7 +28,14 @@ fn index_of(road: &LaneRoad, id: mergesim_types::lanes::LaneId) -> usize {
 }
 
 /// A vehicle on `lane` at (s, d), heading along the lane plus `yaw_offset_rad`.
-fn on_lane(road: &LaneRoad, lane: usize, s_m: f64, d_m: f64, yaw_offset_rad: f64, v: f64) -> VehicleState {
+fn on_lane(
+    road: &LaneRoad,
+    lane: usize,
+    s_m: f64,
+    d_m: f64,
+    yaw_offset_rad: f64,
+    v: f64,
+) -> VehicleState {
     let l = &road.lanes()[lane];
     let p = l.point(s_m, d_m);
     state(p[0], p[1], l.heading_rad(s_m) + yaw_offset_rad, v)
@@ -48,7 +55,10 @@ fn neighbour(id: u32, s: VehicleState) -> Neighbour {
 fn universal_field_gradient_matches_finite_differences_on_the_curved_merge() {
     let road = LaneRoad::new(&curved_spec()).unwrap();
     let geometry = LaneRoadGeometry::new(&road);
-    let (through, ending) = (index_of(&road, THROUGH_LANE_ID), index_of(&road, ENDING_LANE_ID));
+    let (through, ending) = (
+        index_of(&road, THROUGH_LANE_ID),
+        index_of(&road, ENDING_LANE_ID),
+    );
     for form in [HeadingForm::Rotation, HeadingForm::PaperCorrelation] {
         let params = PlannerParams {
             obstacle_heading_form: form,
@@ -63,7 +73,14 @@ fn universal_field_gradient_matches_finite_differences_on_the_curved_merge() {
                 neighbour(1, on_lane(&road, through, 150.0, 0.3, 0.04, 15.0)),
                 neighbour(2, on_lane(&road, ending, 100.0, -0.2, -0.03, 22.0)),
             ];
-            let field = PotentialField::new(&params, &geometry, 0, &ego, &VehicleShape::default(), &others);
+            let field = PotentialField::new(
+                &params,
+                &geometry,
+                0,
+                &ego,
+                &VehicleShape::default(),
+                &others,
+            );
             assert_eq!(field.target_lane, through);
             let mut worst = 0.0_f64;
             for i in 0..400 {
@@ -117,7 +134,10 @@ fn a_rotated_copy_of_the_road_gives_the_same_field() {
             .collect(),
         tolerances: spec.tolerances.clone(),
     };
-    let (a, b) = (LaneRoad::new(&spec).unwrap(), LaneRoad::new(&moved).unwrap());
+    let (a, b) = (
+        LaneRoad::new(&spec).unwrap(),
+        LaneRoad::new(&moved).unwrap(),
+    );
     let (ga, gb) = (LaneRoadGeometry::new(&a), LaneRoadGeometry::new(&b));
     let (through, ending) = (index_of(&a, THROUGH_LANE_ID), index_of(&a, ENDING_LANE_ID));
     let rotate_state = |s: VehicleState| {
@@ -147,7 +167,11 @@ fn a_rotated_copy_of_the_road_gives_the_same_field() {
             &VehicleShape::default(),
             &others_b,
         );
-        assert_eq!(fa.road.walls.len(), 1, "the ego in the through lane sees the wall");
+        assert_eq!(
+            fa.road.walls.len(),
+            1,
+            "the ego in the through lane sees the wall"
+        );
         assert_eq!(fa.road.walls.len(), fb.road.walls.len());
         let (sin, cos) = angle.sin_cos();
         let mut worst = 0.0_f64;
@@ -177,13 +201,17 @@ fn a_lane_that_ends_is_never_a_target_and_the_through_lane_does_not_swerve_into_
     for spec in [MergeRoad::default().lane_road_spec(), curved_spec()] {
         let road = Arc::new(LaneRoad::new(&spec).unwrap());
         let geometry = LaneRoadGeometry::shared(road.clone());
-        let (through, ending) = (index_of(&road, THROUGH_LANE_ID), index_of(&road, ENDING_LANE_ID));
+        let (through, ending) = (
+            index_of(&road, THROUGH_LANE_ID),
+            index_of(&road, ENDING_LANE_ID),
+        );
         assert!(geometry.lane_ends(ending) && !geometry.lane_ends(through));
         assert_eq!(geometry.target_lane(ending), through);
         assert_eq!(geometry.target_lane(through), through);
         for kind in PlannerKind::ALL {
             // A van in the through lane at 25 m/s closing on a car at 12 m/s 30 m ahead.
-            let mut van_planner = PfPlanner::new(kind, PlannerParams::default(), road.clone()).unwrap();
+            let mut van_planner =
+                PfPlanner::new(kind, PlannerParams::default(), road.clone()).unwrap();
             let mut van = on_lane(&road, through, 20.0, 0.0, 0.0, 25.0);
             let mut slow = on_lane(&road, through, 50.0, 0.0, 0.0, 12.0);
             let end_s = road.lanes()[ending].length_m();
@@ -232,7 +260,10 @@ fn a_lane_that_ends_is_never_a_target_and_the_through_lane_does_not_swerve_into_
 #[test]
 fn every_planner_merges_on_the_curved_road_and_stays_in_lane() {
     let road = Arc::new(LaneRoad::new(&curved_spec()).unwrap());
-    let (through, ending) = (index_of(&road, THROUGH_LANE_ID), index_of(&road, ENDING_LANE_ID));
+    let (through, ending) = (
+        index_of(&road, THROUGH_LANE_ID),
+        index_of(&road, ENDING_LANE_ID),
+    );
     let shape = VehicleShape::default();
     let half_width_m = 0.5 * shape.width_m;
     let end_s = road.lanes()[ending].length_m();
@@ -278,7 +309,8 @@ fn every_planner_merges_on_the_curved_road_and_stays_in_lane() {
             for i in 0..2 {
                 states[i] = plans[i].kinematic_state_at(&states[i], t_s + 0.1);
                 let p = [states[i].x_m, states[i].y_m];
-                min_clearance_m = min_clearance_m.min(road.signed_distance_to_edge_m(p) - half_width_m);
+                min_clearance_m =
+                    min_clearance_m.min(road.signed_distance_to_edge_m(p) - half_width_m);
             }
             let ego = [states[0].x_m, states[0].y_m];
             let in_through = road.lanes()[through].project(ego);
@@ -290,9 +322,17 @@ fn every_planner_merges_on_the_curved_road_and_stays_in_lane() {
             other_lowest_d = other_lowest_d.min(other.d_m);
         }
         let merged_at_s = merged_at_s.expect("the ego must merge");
-        assert!(merged_at_s < end_s - 20.0, "{kind}: merged at s = {merged_at_s:.1} m of {end_s:.1}");
-        assert!(min_clearance_m > 0.2, "{kind}: clearance to the edges {min_clearance_m:.2} m");
-        let final_d = road.lanes()[through].project([states[0].x_m, states[0].y_m]).d_m;
+        assert!(
+            merged_at_s < end_s - 20.0,
+            "{kind}: merged at s = {merged_at_s:.1} m of {end_s:.1}"
+        );
+        assert!(
+            min_clearance_m > 0.2,
+            "{kind}: clearance to the edges {min_clearance_m:.2} m"
+        );
+        let final_d = road.lanes()[through]
+            .project([states[0].x_m, states[0].y_m])
+            .d_m;
         // Settled in the through lane, its body well inside it (0.945 m each side for a
         // centred car). Measured 2026-12-02: d = 0.30 m for every planner, towards the inside
         // of the curve; the straight road's test settles within 0.3 m of the centre.
