@@ -10,7 +10,7 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use mergesim_types::lanes::{LaneRoad, THROUGH_LANE_ID, curved_merge_spec};
 use planner::attractive_field::AttractiveField;
-use planner::lane_road_field::{LaneAttraction, LaneRoadField, LaneRoadGeometry};
+use planner::lane_road_field::{LaneRoadField, LaneRoadGeometry};
 use planner::road_field::RoadField;
 use planner::{MergeRoad, PlannerParams, VehicleShape};
 
@@ -41,6 +41,13 @@ fn bench(c: &mut Criterion) {
     let geometry = LaneRoadGeometry::new(&lanes);
     let field = LaneRoadField::new(&geometry, &p, half_width_m);
     let target = lanes.lane(THROUGH_LANE_ID).expect("lane").centreline();
+    // The moving target's pull through the prepared frame of the through lane, as the
+    // planner's `PotentialField::moving_target_gradient` computes it.
+    let through = lanes
+        .lanes()
+        .iter()
+        .position(|l| l.id() == THROUGH_LANE_ID)
+        .expect("lane");
     let pts = points(|x, y| [x, y]);
     let (gain, lookahead) = (p.attractive_gain_per_m2, p.target_lookahead_m);
     c.bench_function("road_terms_today_straight_64_points", |b| {
@@ -60,7 +67,11 @@ fn bench(c: &mut Criterion) {
             let mut acc = [0.0, 0.0];
             for q in black_box(&pts) {
                 let g = field.gradient(q[0], q[1]);
-                let a = LaneAttraction::moving_target_gradient(target, gain, lookahead, q[0], q[1]);
+                let j = geometry.jacobian(through, *q);
+                let a = [
+                    -gain * lookahead * j.grad_s[0],
+                    -gain * lookahead * j.grad_s[1],
+                ];
                 acc[0] += g[0] + a[0];
                 acc[1] += g[1] + a[1];
             }
@@ -79,13 +90,11 @@ fn bench(c: &mut Criterion) {
             let mut acc = [0.0, 0.0];
             for q in black_box(&curved_pts) {
                 let g = curved_field.gradient(q[0], q[1]);
-                let a = LaneAttraction::moving_target_gradient(
-                    curved_target,
-                    gain,
-                    lookahead,
-                    q[0],
-                    q[1],
-                );
+                let j = curved_geometry.jacobian(through, *q);
+                let a = [
+                    -gain * lookahead * j.grad_s[0],
+                    -gain * lookahead * j.grad_s[1],
+                ];
                 acc[0] += g[0] + a[0];
                 acc[1] += g[1] + a[1];
             }

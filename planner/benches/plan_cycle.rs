@@ -29,8 +29,12 @@ fn plan_cycle(c: &mut Criterion) {
         speed_mps: 15.0,
     };
     // The neighbour's SLP: its own PF-ISO plan at the same instant.
-    let mut other_planner =
-        PfPlanner::new(PlannerKind::PfIso, params.clone(), road.clone()).expect("valid");
+    let mut other_planner = PfPlanner::new(
+        PlannerKind::PfIso,
+        params.clone(),
+        road.lane_road().expect("valid road"),
+    )
+    .expect("valid");
     let ego_as_neighbour = [Neighbour {
         id: 0,
         state: ego,
@@ -64,7 +68,12 @@ fn plan_cycle(c: &mut Criterion) {
         neighbours: &neighbours,
         shared_paths: &shared,
     };
-    let mut planner = PfPlanner::new(PlannerKind::PfIso, params, road).expect("valid");
+    let mut planner = PfPlanner::new(
+        PlannerKind::PfIso,
+        params,
+        road.lane_road().expect("valid road"),
+    )
+    .expect("valid");
     let plan = planner.plan(&request).expect("valid request");
     assert!(plan.fallback.is_none());
     let stats = planner.last_stats();
@@ -78,7 +87,7 @@ fn plan_cycle(c: &mut Criterion) {
     let mut fresh = PfPlanner::new(
         PlannerKind::PfIso,
         planner.params().clone(),
-        planner.road().clone(),
+        planner.shared_road(),
     )
     .expect("valid");
     c.bench_function("pf_iso_plan_cycle_cold_solver", |b| {
@@ -86,7 +95,7 @@ fn plan_cycle(c: &mut Criterion) {
             fresh = PfPlanner::new(
                 PlannerKind::PfIso,
                 planner.params().clone(),
-                planner.road().clone(),
+                planner.shared_road(),
             )
             .expect("valid");
             fresh.plan(black_box(&request))
@@ -102,7 +111,7 @@ fn plan_cycle(c: &mut Criterion) {
     let mut other_planner = PfPlanner::new(
         PlannerKind::PfIso,
         planner.params().clone(),
-        planner.road().clone(),
+        planner.shared_road(),
     )
     .expect("valid");
     let moving: Vec<(f64, VehicleState, VehicleState, SharedLocalPathVec)> = (0..cycles)
@@ -160,9 +169,15 @@ fn plan_cycle(c: &mut Criterion) {
             with(SpeedProgram::Cone, 2, 0.0),
         ),
     ] {
+        // A fresh planner on the road already prepared (as a simulation builds its planners
+        // once per run; before the lane frame this cloned the `MergeRoad`).
         let fresh = || {
-            PfPlanner::new(PlannerKind::PfIso, params.clone(), planner.road().clone())
-                .expect("valid")
+            PfPlanner::on_geometry(
+                PlannerKind::PfIso,
+                params.clone(),
+                planner.road_geometry().clone(),
+            )
+            .expect("valid")
         };
         let mut moving_planner = fresh();
         let mut next = 0;
@@ -196,7 +211,7 @@ fn plan_cycle(c: &mut Criterion) {
     let mut sp = PfPlanner::new(
         PlannerKind::PfSp,
         planner.params().clone(),
-        planner.road().clone(),
+        planner.shared_road(),
     )
     .expect("valid");
     c.bench_function("pf_sp_plan_cycle_n20", |b| {

@@ -66,7 +66,13 @@ struct Outcome {
 fn roll_out(kind: PlannerKind, obstacle_x_m: f64) -> Result<Outcome, Box<dyn std::error::Error>> {
     let road = MergeRoad::default();
     let shape = VehicleShape::default();
-    let new = || PfPlanner::new(kind, PlannerParams::default(), road.clone());
+    let new = || {
+        PfPlanner::new(
+            kind,
+            PlannerParams::default(),
+            road.lane_road().expect("valid road"),
+        )
+    };
     let mut planners = [new()?, new()?];
     let y_lower_m = road.lane_center_y_m(Lane::Lower);
     let y_upper_m = road.lane_center_y_m(Lane::Upper);

@@ -1,4 +1,6 @@
-//! Attractive potential field, paper Eq. 1.
+//! Attractive potential field, paper Eq. 1, on the straight `MergeRoad` (X along it). The
+//! planners pull along the target lane's centreline (`PotentialField::moving_target_gradient`);
+//! this is the reference of the tests and the `lane_road_field` bench.
 //!
 //! U_AT = ½ λ (X − X_tar)². The paper leaves X_tar open; read literally, a fixed target makes
 //! the pull fade to zero as the vehicle approaches it. We read X_tar as a moving target a

@@ -74,7 +74,13 @@ mod tests {
             neighbours: &[],
             shared_paths: &[],
         };
-        let new = || PfPlanner::new(PlannerKind::PfIso, PlannerParams::default(), road.clone());
+        let new = || {
+            PfPlanner::new(
+                PlannerKind::PfIso,
+                PlannerParams::default(),
+                road.lane_road().unwrap(),
+            )
+        };
         let mut behaviour = new().unwrap();
         let decision = Behaviour::plan(&mut behaviour, &obs).unwrap();
         let plan = new().unwrap().plan(&request(&obs)).unwrap();

@@ -26,6 +26,9 @@ pub enum PlannerError {
         /// The valid names, comma separated.
         valid: String,
     },
+    /// The road's lanes are inconsistent (the error names the lane and what is wrong).
+    #[error(transparent)]
+    Road(#[from] mergesim_types::lanes::LaneError),
     /// The convex solver did not reach a usable solution.
     #[error("solver failed in {problem}: status {status}")]
     SolverFailed {

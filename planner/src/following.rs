@@ -35,6 +35,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::lane_road_field::LaneRoadGeometry;
 use crate::params::PlannerParams;
 use crate::types::{Neighbour, VehicleId, VehicleShape, VehicleState};
 
@@ -127,6 +128,40 @@ pub fn following_cap_mps(
             safe_following_speed_mps(params, bumper_gap_m(ego, ego_shape, n), n.state.speed_mps)
         })
         .reduce(f64::min)
+}
+
+/// [`following_cap_mps`] on a road of lanes: the ego, the neighbours and the path are first
+/// mapped into the frame of the ego's lane (x → s along it, y → d across it), so "ahead", the
+/// bumper gap and the corridor are measured along the road, curved or not (on a straight road
+/// along +x the same figures as in world coordinates).
+pub fn following_cap_in_lane_frame_mps(
+    params: &PlannerParams,
+    road: &LaneRoadGeometry,
+    ego_id: VehicleId,
+    ego: &VehicleState,
+    ego_shape: &VehicleShape,
+    neighbours: &[Neighbour],
+    path: &[[f64; 2]],
+) -> Option<f64> {
+    let lane = road.lane_index_at([ego.x_m, ego.y_m]);
+    let to_frame = |p: [f64; 2]| {
+        let j = road.jacobian(lane, p);
+        [j.frame.s_m, j.frame.d_m]
+    };
+    let state_in_frame = |s: &VehicleState| {
+        let [x_m, y_m] = to_frame([s.x_m, s.y_m]);
+        VehicleState { x_m, y_m, ..*s }
+    };
+    let ego_f = state_in_frame(ego);
+    let neighbours_f: Vec<Neighbour> = neighbours
+        .iter()
+        .map(|n| Neighbour {
+            state: state_in_frame(&n.state),
+            ..*n
+        })
+        .collect();
+    let path_f: Vec<[f64; 2]> = path.iter().map(|p| to_frame(*p)).collect();
+    following_cap_mps(params, ego_id, &ego_f, ego_shape, &neighbours_f, &path_f)
 }
 
 #[cfg(test)]

@@ -56,7 +56,7 @@ pub fn to_world_gradient(j: &FrameJacobian, du_ds: f64, du_dd: f64) -> [f64; 2] 
 }
 
 /// Wraps an angle to (−π, π] (rad).
-fn wrap_rad(a: f64) -> f64 {
+pub(crate) fn wrap_rad(a: f64) -> f64 {
     let w = (a + PI).rem_euclid(2.0 * PI) - PI;
     if w == -PI { PI } else { w }
 }

@@ -44,8 +44,6 @@ fn unit(a: [f64; 2]) -> [f64; 2] {
 /// One outer edge, ready for distance queries (local coordinates).
 #[derive(Clone, Debug)]
 pub(crate) struct EdgeGeometry {
-    /// Vertices relative to the road's origin, zero-length segments removed.
-    pts: Vec<[f64; 2]>,
     /// Unit direction of each segment.
     dir: Vec<[f64; 2]>,
     /// The first segment continues backwards without end.
@@ -57,6 +55,22 @@ pub(crate) struct EdgeGeometry {
     /// Per block of segments: [min, max] corners of the box of its vertices (a ray's finite
     /// part only: the rays are always tested).
     boxes: Vec<[[f64; 2]; 2]>,
+    /// Per segment, prepared for the foot-point search: start, edge vector, 1/|edge|² and the
+    /// bounds of the foot parameter t (−∞ / +∞ on a ray).
+    segs: Vec<Segment>,
+    /// A single segment continued as a ray at both ends is a straight line: its point and
+    /// unit normal towards the drivable side (the signed distance is then one dot product).
+    line: Option<([f64; 2], [f64; 2])>,
+}
+
+/// One segment, prepared.
+#[derive(Clone, Copy, Debug)]
+struct Segment {
+    a: [f64; 2],
+    e: [f64; 2],
+    inv_len2: f64,
+    t_lo: f64,
+    t_hi: f64,
 }
 
 /// The nearest point of an edge: signed clearance-side distance and its gradient.
@@ -145,53 +159,81 @@ impl EdgeGeometry {
                         [lo, hi]
                     })
                     .collect();
+                let segs = (0..nseg)
+                    .map(|k| {
+                        let a = pts[k];
+                        let e = sub(pts[k + 1], a);
+                        Segment {
+                            a,
+                            e,
+                            inv_len2: 1.0 / dot(e, e),
+                            t_lo: if ray_start && k == 0 {
+                                f64::NEG_INFINITY
+                            } else {
+                                0.0
+                            },
+                            t_hi: if ray_end && k + 1 == nseg {
+                                f64::INFINITY
+                            } else {
+                                1.0
+                            },
+                        }
+                    })
+                    .collect();
+                let line = (nseg == 1 && ray_start && ray_end)
+                    .then(|| (pts[0], [-inside_sign * dir[0][1], inside_sign * dir[0][0]]));
                 Some(Self {
-                    pts,
                     dir,
                     ray_start,
                     ray_end,
                     inside_sign,
                     boxes,
+                    segs,
+                    line,
                 })
             })
             .collect()
     }
 
-    /// Distance from `q` (local) to segment k (with the rays), its foot parameter clamped flag.
-    /// Returns (distance², foot, where: -1 at the segment's start vertex, 1 at its end vertex,
-    /// 0 inside).
+    /// Distance² from `q` (local) to segment k (with the rays), the foot point, and where the
+    /// foot lies: -1 at the segment's start vertex, 1 at its end vertex, 0 inside.
+    #[inline]
     fn segment(&self, k: usize, q: [f64; 2]) -> (f64, [f64; 2], i8) {
-        let a = self.pts[k];
-        let e = sub(self.pts[k + 1], a);
-        let len2 = dot(e, e);
-        let t = dot(sub(q, a), e) / len2;
-        let last = self.dir.len() - 1;
-        let lo = if self.ray_start && k == 0 {
-            f64::NEG_INFINITY
-        } else {
-            0.0
-        };
-        let hi = if self.ray_end && k == last {
-            f64::INFINITY
-        } else {
-            1.0
-        };
-        let (t, at) = if t <= lo {
-            (lo, -1)
-        } else if t >= hi {
-            (hi, 1)
+        let sg = &self.segs[k];
+        let t = dot(sub(q, sg.a), sg.e) * sg.inv_len2;
+        let (t, at) = if t <= sg.t_lo {
+            (sg.t_lo, -1)
+        } else if t >= sg.t_hi {
+            (sg.t_hi, 1)
         } else {
             (t, 0)
         };
-        let foot = [a[0] + t * e[0], a[1] + t * e[1]];
+        let foot = [sg.a[0] + t * sg.e[0], sg.a[1] + t * sg.e[1]];
         let w = sub(q, foot);
         (dot(w, w), foot, at)
     }
 
     /// Signed distance (positive on the drivable side) from `q` (local) and its gradient.
+    #[inline]
     pub(crate) fn distance(&self, q: [f64; 2]) -> EdgeDistance {
-        let nseg = self.dir.len();
+        if let Some((a, n)) = self.line {
+            return EdgeDistance {
+                distance_m: dot(sub(q, a), n),
+                gradient: n,
+            };
+        }
+        let nseg = self.segs.len();
         let mut best = (f64::INFINITY, [0.0, 0.0], 0_i8, 0_usize);
+        if self.boxes.len() <= 1 {
+            // One block (every edge of a straight road): test each segment, rays included.
+            for k in 0..nseg {
+                let (d2, foot, at) = self.segment(k, q);
+                if d2 < best.0 {
+                    best = (d2, foot, at, k);
+                }
+            }
+            return self.signed(q, best);
+        }
         let box_d2 = |b: &[[f64; 2]; 2]| {
             let dx = (b[0][0] - q[0]).max(0.0).max(q[0] - b[1][0]);
             let dy = (b[0][1] - q[1]).max(0.0).max(q[1] - b[1][1]);
@@ -229,6 +271,13 @@ impl EdgeGeometry {
                 scan(bi, &mut best);
             }
         }
+        self.signed(q, best)
+    }
+
+    /// The signed distance and its gradient from the nearest foot point found.
+    #[inline]
+    fn signed(&self, q: [f64; 2], best: (f64, [f64; 2], i8, usize)) -> EdgeDistance {
+        let nseg = self.segs.len();
         let (d2, foot, at, k) = best;
         let dist = d2.sqrt();
         // Side: the segment's normal inside it (or on a ray); the bisector at a vertex.
@@ -251,7 +300,8 @@ impl EdgeGeometry {
             -self.inside_sign
         };
         let gradient = if dist > 0.0 {
-            [sign * w[0] / dist, sign * w[1] / dist]
+            let k = sign / dist;
+            [k * w[0], k * w[1]]
         } else {
             // On the edge: the inward normal of its segment.
             let n = [-self.dir[k][1], self.dir[k][0]];

@@ -1,14 +1,15 @@
 //! The road terms of the potential field (paper Eqs. 1–3) on a road made of lanes
-//! ([`LaneRoad`]), with their world gradients for Eq. 7. Not yet used by the planners (they run
-//! on [`MergeRoad`](crate::road::MergeRoad) through `road_field.rs` and `attractive_field.rs`);
-//! on the straight merge road both give the same values (tests in
+//! ([`LaneRoad`]), with their world gradients for Eq. 7: what the planners step in. On the
+//! straight merge road they give today's straight-road field (`road_field.rs`,
+//! `attractive_field.rs`, kept as the reference of the tests in
 //! `planner/tests/lane_road_field.rs`). The formulas are in planner/README.md, "The road terms
 //! in the lane frame".
 //!
-//! - **Eq. 1** ([`LaneAttraction`]): U_AT = ½ λ (s − s_tar)², s along the target lane's
-//!   centreline, the target at (s_tar, d = 0) with s_tar = s_ego + look-ahead. Like the straight
-//!   road's ½ λ (X − X_tar)² it measures only the distance along the road (no lateral spring:
-//!   lateral placement is the divider's and the edges' job). The moving target's pull is
+//! - **Eq. 1** ([`LaneAttraction`], and through the prepared frames
+//!   `PotentialField::moving_target_gradient`): U_AT = ½ λ (s − s_tar)², s along the target
+//!   lane's centreline ([`LaneRoadGeometry::target_lane`]: never a lane that ends), the target
+//!   at (s_tar, d = 0) with s_tar = s_ego + look-ahead. Like the straight road's
+//!   ½ λ (X − X_tar)² it measures only the distance along the road. The moving target's pull is
 //!   −λ·look-ahead·∇s.
 //! - **Eq. 2**: for each divider between same-direction lanes ([`LaneRoad::dividers`]), in the
 //!   frame of the lane whose bound it is, U_LD = A exp(−(d − d_div(s))² / 2σ²) where the divider
@@ -17,15 +18,26 @@
 //!   lane end included), e(g) with the clearance g = δ − l_w/2, δ the signed Euclidean distance
 //!   to the edge (positive on the road), e the straight road's ½ ξ/g² with its linear
 //!   continuation below g_c (`road_field.rs`).
+//! - **Lane-end rule**: a vehicle in a lane that goes on sees the divider towards a neighbour
+//!   that ends as Eq. 3's edge, cut off at [`LANE_END_WALL_CUTOFF_M`] ([`wall_term`],
+//!   [`LaneRoadGeometry::lane_end_walls`]).
 //! - **Eq. 7**: ∇U = ∂U/∂s ∇s + ∂U/∂d ∇d (`lane_frame.rs`); the edge term's gradient is the
 //!   distance's own, e'(g)·∇δ.
+//!
+//! Cost: straight lanes are projected in O(1) and constant bounds need no interpolation
+//! (`lane_road_frames.rs`); an edge that is one straight line is one dot product, an edge of a
+//! few segments is searched without its bounding boxes (`lane_road_edges.rs`).
 
-use mergesim_types::lanes::{Centreline, Divider, Lane, LaneId, LaneRoad, Side};
+use std::sync::Arc;
+
+use mergesim_types::lanes::{Centreline, Divider, FramePoint, Lane, LaneId, LaneRoad, Side};
 
 use crate::lane_frame::{FrameJacobian, frame_jacobian, to_world_gradient};
 use crate::lane_road_edges::EdgeGeometry;
+use crate::lane_road_frames::{BoundOffset, FastFrame};
 use crate::params::PlannerParams;
 use crate::road_field::edge_term;
+use crate::types::VehicleState;
 
 /// One divider prepared for Eq. 2: the lane whose bound it is, which bound, and where it holds.
 #[derive(Clone, Debug)]
@@ -36,16 +48,44 @@ struct DividerGeometry {
     side: Side,
     /// s range on that lane (m); ±∞ where it reaches the road's open start or end.
     s_range_m: [f64; 2],
+    /// d_div(s), prepared.
+    offset: BoundOffset,
+    /// Index of the lane to the divider's left and to its right.
+    left_lane: usize,
+    right_lane: usize,
 }
 
-/// What Eqs. 2–3 need of a [`LaneRoad`], prepared once per road: the dividers in their lanes'
-/// frames and the outer edges with their drivable sides.
+/// The lane-end rule's wall acts only at body clearances below this (m): beyond it its term is
+/// zero, so a vehicle near its lane's centre (clearance (w − l_w)/2 = 0.945 m for a 1.61 m car
+/// in a 3.5 m lane) sees the same field as without the rule, and only a path pushed towards
+/// the lane that ends meets it.
+pub const LANE_END_WALL_CUTOFF_M: f64 = 0.5;
+
+/// The lane-end wall's term at body clearance g and its slope: Eq. 3's e(g) (with its linear
+/// continuation below g_c) less its tangent at the cut-off g_w = [`LANE_END_WALL_CUTOFF_M`],
+/// zero beyond g_w: e(g) − e(g_w) − e'(g_w)(g − g_w), C¹ at g_w.
+pub fn wall_term(gain_m2: f64, clamp_m: f64, clearance_m: f64) -> (f64, f64) {
+    let cut = LANE_END_WALL_CUTOFF_M;
+    if clearance_m >= cut {
+        return (0.0, 0.0);
+    }
+    let (e, de) = edge_term(gain_m2, clamp_m, clearance_m);
+    let (e_cut, de_cut) = edge_term(gain_m2, clamp_m, cut);
+    (e - e_cut - de_cut * (clearance_m - cut), de - de_cut)
+}
+
+/// What Eqs. 1–3 need of a [`LaneRoad`], prepared once per road: each lane's frame (straight
+/// lanes in O(1)), the dividers in their lanes' frames, the outer edges with their drivable
+/// sides, and which lanes end.
 #[derive(Clone, Debug)]
-pub struct LaneRoadGeometry<'a> {
-    road: &'a LaneRoad,
+pub struct LaneRoadGeometry {
+    road: Arc<LaneRoad>,
     origin_m: [f64; 2],
+    frames: Vec<FastFrame>,
     dividers: Vec<DividerGeometry>,
     edges: Vec<EdgeGeometry>,
+    /// Per lane: it ends closed beside a lane that goes on ([`LaneRoad::lane_end`]).
+    ends: Vec<bool>,
 }
 
 /// Slack on s-range ends when deciding that a divider reaches a lane's end (m).
@@ -74,31 +114,58 @@ fn divider_geometry(road: &LaneRoad, d: &Divider) -> Option<DividerGeometry> {
         lane,
         side,
         s_range_m: [a, b],
+        offset: BoundOffset::of(l, side),
+        left_lane: index(d.left_lane)?,
+        right_lane: index(d.right_lane)?,
     })
 }
 
-impl<'a> LaneRoadGeometry<'a> {
-    /// Prepares the road's dividers and outer edges.
-    pub fn new(road: &'a LaneRoad) -> Self {
+impl LaneRoadGeometry {
+    /// Prepares the road's frames, dividers and outer edges (a copy of `road` is kept).
+    pub fn new(road: &LaneRoad) -> Self {
+        Self::shared(Arc::new(road.clone()))
+    }
+
+    /// Prepares a shared road.
+    pub fn shared(road: Arc<LaneRoad>) -> Self {
         let origin_m = road
             .lanes()
             .first()
             .map_or([0.0, 0.0], |l| l.centreline().origin_m());
+        let frames = road
+            .lanes()
+            .iter()
+            .map(|l| FastFrame::of(l.centreline()))
+            .collect();
+        let dividers = road
+            .dividers()
+            .iter()
+            .filter_map(|d| divider_geometry(&road, d))
+            .collect();
+        let edges = EdgeGeometry::all(&road, origin_m);
+        let ends = road
+            .lanes()
+            .iter()
+            .map(|l| road.lane_end(l.id()).is_some_and(|e| e.closed))
+            .collect();
         Self {
             road,
             origin_m,
-            dividers: road
-                .dividers()
-                .iter()
-                .filter_map(|d| divider_geometry(road, d))
-                .collect(),
-            edges: EdgeGeometry::all(road, origin_m),
+            frames,
+            dividers,
+            edges,
+            ends,
         }
     }
 
     /// The road.
-    pub fn road(&self) -> &'a LaneRoad {
-        self.road
+    pub fn road(&self) -> &LaneRoad {
+        &self.road
+    }
+
+    /// The road, shared.
+    pub fn shared_road(&self) -> &Arc<LaneRoad> {
+        &self.road
     }
 
     /// Number of outer edges the edge term sums over.
@@ -119,14 +186,168 @@ impl<'a> LaneRoadGeometry<'a> {
             .map(|e| e.distance(q).distance_m)
             .collect()
     }
+
+    /// (s, d) of a point in lane `lane` (index into [`LaneRoad::lanes`]) with ∇s and ∇d.
+    #[inline]
+    pub fn jacobian(&self, lane: usize, p_m: [f64; 2]) -> FrameJacobian {
+        self.frames[lane].jacobian(self.road.lanes()[lane].centreline(), p_m)
+    }
+
+    /// Arc length s of a point in lane `lane`'s frame (m).
+    #[inline]
+    pub fn s_m(&self, lane: usize, p_m: [f64; 2]) -> f64 {
+        self.frames[lane]
+            .project(self.road.lanes()[lane].centreline(), p_m)
+            .s_m
+    }
+
+    /// Index of the lane holding the point and the point's (s, d) in it: as
+    /// [`LaneRoad::nearest_lane`] (smallest frame excess, ties to the smaller |d|, then to the
+    /// description order), through the prepared frames.
+    pub fn lane_at(&self, p_m: [f64; 2]) -> (usize, FramePoint) {
+        let mut best: Option<(usize, FramePoint, f64)> = None;
+        for (i, l) in self.road.lanes().iter().enumerate() {
+            let fp = self.frames[i].project(l.centreline(), p_m);
+            let excess = l.frame_excess_m(fp);
+            let better = best
+                .is_none_or(|(_, b, e)| excess < e || (excess == e && fp.d_m.abs() < b.d_m.abs()));
+            if better {
+                best = Some((i, fp, excess));
+            }
+        }
+        best.map_or((0, FramePoint { s_m: 0.0, d_m: 0.0 }), |(i, fp, _)| (i, fp))
+    }
+
+    /// Index of the lane holding the point ([`LaneRoadGeometry::lane_at`]).
+    pub fn lane_index_at(&self, p_m: [f64; 2]) -> usize {
+        self.lane_at(p_m).0
+    }
+
+    /// The smoothed heading of lane `lane` at `s_m` (rad; a straight lane's direction).
+    pub fn lane_heading_rad(&self, lane: usize, s_m: f64) -> f64 {
+        match &self.frames[lane] {
+            FastFrame::Straight { tangent, .. } => tangent[1].atan2(tangent[0]),
+            FastFrame::General => self.road.lanes()[lane].heading_rad(s_m),
+        }
+    }
+
+    /// On which side of lane `lane` its neighbour `other` lies (across a divider).
+    pub fn side_of_neighbour(&self, lane: usize, other: usize) -> Option<Side> {
+        self.dividers.iter().find_map(|dg| {
+            if dg.right_lane == lane && dg.left_lane == other {
+                Some(Side::Left)
+            } else if dg.left_lane == lane && dg.right_lane == other {
+                Some(Side::Right)
+            } else {
+                None
+            }
+        })
+    }
+
+    /// The unit tangent of lane `lane` if its centreline is straight.
+    pub fn straight_tangent(&self, lane: usize) -> Option<[f64; 2]> {
+        match &self.frames[lane] {
+            FastFrame::Straight { tangent, .. } => Some(*tangent),
+            FastFrame::General => None,
+        }
+    }
+
+    /// The heading of the lane holding the point, at the point's s (rad): Eq. 4's reference
+    /// for an obstacle's heading.
+    pub fn lane_heading_at_rad(&self, p_m: [f64; 2]) -> f64 {
+        let (lane, fp) = self.lane_at(p_m);
+        self.lane_heading_rad(lane, fp.s_m)
+    }
+
+    /// Whether lane `lane` ends ahead (closed, beside a lane that goes on): never a target.
+    pub fn lane_ends(&self, lane: usize) -> bool {
+        self.ends.get(lane).copied().unwrap_or(false)
+    }
+
+    /// The target lane of a vehicle in lane `lane` (lane-end rule): its own lane, unless that
+    /// ends; then the first neighbour across one of its dividers that does not end (the lane
+    /// it must merge into); its own lane if there is none.
+    pub fn target_lane(&self, lane: usize) -> usize {
+        if !self.lane_ends(lane) {
+            return lane;
+        }
+        self.dividers
+            .iter()
+            .filter_map(|dg| {
+                if dg.left_lane == lane {
+                    Some(dg.right_lane)
+                } else if dg.right_lane == lane {
+                    Some(dg.left_lane)
+                } else {
+                    None
+                }
+            })
+            .find(|&other| !self.lane_ends(other))
+            .unwrap_or(lane)
+    }
+
+    /// The dividers that a vehicle in `state` (half-width `half_width_m`) sees as walls under
+    /// the lane-end rule, with the sign that makes δ = sign·(d − d_div) positive on its side,
+    /// and the lane it is settled in (to pass back on its next cycle as `settled_lane`).
+    ///
+    /// The walls are the dividers between its lane, if that goes on, and a neighbour that ends
+    /// ahead. They apply once the vehicle is *settled* in its lane: its body's clearance to each
+    /// of them at least [`LANE_END_WALL_CUTOFF_M`] now (where the wall's term is zero, so it
+    /// appears without a jolt: a vehicle that has just merged meets no wall pushing at it), or
+    /// settled at its previous cycle in the same lane (`settled_lane`, the lane index) — then
+    /// they stay while its centre is in that lane, however close a push brings it.
+    pub fn lane_end_walls(
+        &self,
+        state: &VehicleState,
+        half_width_m: f64,
+        settled_lane: Option<usize>,
+    ) -> (Vec<(usize, f64)>, Option<usize>) {
+        let p = [state.x_m, state.y_m];
+        let lane = self.lane_index_at(p);
+        if self.lane_ends(lane) {
+            return (Vec::new(), None);
+        }
+        let lanes = self.road.lanes();
+        let mut walls = Vec::new();
+        let mut clear = true;
+        for (k, dg) in self.dividers.iter().enumerate() {
+            let (sign, other) = if dg.left_lane == lane {
+                (1.0, dg.right_lane)
+            } else if dg.right_lane == lane {
+                (-1.0, dg.left_lane)
+            } else {
+                continue;
+            };
+            if !self.lane_ends(other) {
+                continue;
+            }
+            let l = &lanes[dg.lane];
+            let s = self.frames[dg.lane].project(l.centreline(), p);
+            if s.s_m.is_nan() || s.s_m >= dg.s_range_m[1] {
+                continue;
+            }
+            let (d_div, _) = dg.offset.at(l, dg.side, s.s_m);
+            let clearance = sign * (s.d_m - d_div) - half_width_m;
+            clear &= clearance >= LANE_END_WALL_CUTOFF_M;
+            walls.push((k, sign));
+        }
+        if walls.is_empty() {
+            return (walls, None);
+        }
+        if settled_lane == Some(lane) || clear {
+            (walls, Some(lane))
+        } else {
+            (Vec::new(), None)
+        }
+    }
 }
 
 /// The road terms (Eqs. 2–3) of one vehicle on a road of lanes: [`RoadField`](crate::road_field::RoadField)
 /// generalised through the lane frame, with the same parameters.
-#[derive(Clone, Copy, Debug)]
-pub struct LaneRoadField<'g, 'a> {
+#[derive(Clone, Debug)]
+pub struct LaneRoadField<'g> {
     /// The road, prepared.
-    pub geometry: &'g LaneRoadGeometry<'a>,
+    pub geometry: &'g LaneRoadGeometry,
     /// A_lane.
     pub lane_amplitude: f64,
     /// σ of the divider (m).
@@ -137,15 +358,14 @@ pub struct LaneRoadField<'g, 'a> {
     pub edge_clamp_distance_m: f64,
     /// l_w / 2 of the vehicle (m).
     pub half_width_m: f64,
+    /// The dividers this vehicle sees as walls (lane-end rule): (divider index, sign of δ).
+    pub walls: Vec<(usize, f64)>,
 }
 
-impl<'g, 'a> LaneRoadField<'g, 'a> {
-    /// The field with the planner's parameters (the same as `PotentialField`'s road field).
-    pub fn new(
-        geometry: &'g LaneRoadGeometry<'a>,
-        params: &PlannerParams,
-        half_width_m: f64,
-    ) -> Self {
+impl<'g> LaneRoadField<'g> {
+    /// The field with the planner's parameters (the same as `PotentialField`'s road field),
+    /// without lane-end walls.
+    pub fn new(geometry: &'g LaneRoadGeometry, params: &PlannerParams, half_width_m: f64) -> Self {
         Self {
             geometry,
             lane_amplitude: params.lane_amplitude,
@@ -153,37 +373,58 @@ impl<'g, 'a> LaneRoadField<'g, 'a> {
             edge_gain_m2: params.edge_gain_m2,
             edge_clamp_distance_m: params.edge_clamp_distance_m,
             half_width_m,
+            walls: Vec::new(),
         }
     }
 
-    /// Each divider's (frame jacobian, d − d_div, d_div') where it holds at the point.
+    /// The field of a vehicle in `state`, with the lane-end rule's walls
+    /// ([`LaneRoadGeometry::lane_end_walls`] without a previous cycle: walls only if the vehicle
+    /// is settled now): [`wall_term`] along each, in d − d_div(s).
+    pub fn for_vehicle(
+        geometry: &'g LaneRoadGeometry,
+        params: &PlannerParams,
+        half_width_m: f64,
+        state: &VehicleState,
+    ) -> Self {
+        Self {
+            walls: geometry.lane_end_walls(state, half_width_m, None).0,
+            ..Self::new(geometry, params, half_width_m)
+        }
+    }
+
+    /// Visits each divider that holds at the point: (its index, frame jacobian,
+    /// δ = d − d_div, d_div', U_LD of it).
+    #[inline]
     fn divider_terms(
         &self,
         x_m: f64,
         y_m: f64,
-        mut visit: impl FnMut(&FrameJacobian, f64, f64, f64),
+        mut visit: impl FnMut(usize, &FrameJacobian, f64, f64, f64),
     ) {
         let lanes = self.geometry.road.lanes();
-        for dg in &self.geometry.dividers {
+        let s2 = self.lane_sigma_m * self.lane_sigma_m;
+        for (k, dg) in self.geometry.dividers.iter().enumerate() {
             let lane = &lanes[dg.lane];
-            let c: &Centreline = lane.centreline();
-            let j = frame_jacobian(c, [x_m, y_m]);
+            let j = self.geometry.frames[dg.lane].jacobian(lane.centreline(), [x_m, y_m]);
             let s = j.frame.s_m;
             if !(s >= dg.s_range_m[0] && s < dg.s_range_m[1]) {
                 continue;
             }
-            let (d_div, slope) = lane.bound_d_and_slope(dg.side, s);
+            let (d_div, slope) = dg.offset.at(lane, dg.side, s);
             let delta = j.frame.d_m - d_div;
-            let s2 = self.lane_sigma_m * self.lane_sigma_m;
             let u = self.lane_amplitude * (-delta * delta / (2.0 * s2)).exp();
-            visit(&j, delta, slope, u);
+            visit(k, &j, delta, slope, u);
         }
+    }
+
+    fn wall_sign(&self, k: usize) -> Option<f64> {
+        self.walls.iter().find(|w| w.0 == k).map(|w| w.1)
     }
 
     /// U_LD at (x, y), Eq. 2 in the lane frame: the sum over the dividers that hold there.
     pub fn lane_value(&self, x_m: f64, y_m: f64) -> f64 {
         let mut v = 0.0;
-        self.divider_terms(x_m, y_m, |_, _, _, u| v += u);
+        self.divider_terms(x_m, y_m, |_, _, _, _, u| v += u);
         v
     }
 
@@ -191,11 +432,45 @@ impl<'g, 'a> LaneRoadField<'g, 'a> {
     pub fn lane_gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
         let s2 = self.lane_sigma_m * self.lane_sigma_m;
         let mut g = [0.0, 0.0];
-        self.divider_terms(x_m, y_m, |j, delta, slope, u| {
+        self.divider_terms(x_m, y_m, |_, j, delta, slope, u| {
             let du_dd = -u * delta / s2;
             let w = to_world_gradient(j, -du_dd * slope, du_dd);
             g[0] += w[0];
             g[1] += w[1];
+        });
+        g
+    }
+
+    /// The lane-end walls' term at (x, y): [`wall_term`] of the body clearance
+    /// g = sign·(d − d_div) − l_w/2 per wall (Eq. 3's edge, cut off at [`LANE_END_WALL_CUTOFF_M`]).
+    pub fn wall_value(&self, x_m: f64, y_m: f64) -> f64 {
+        if self.walls.is_empty() {
+            return 0.0;
+        }
+        let mut v = 0.0;
+        self.divider_terms(x_m, y_m, |k, _, delta, _, _| {
+            if let Some(sign) = self.wall_sign(k) {
+                let g = sign * delta - self.half_width_m;
+                v += wall_term(self.edge_gain_m2, self.edge_clamp_distance_m, g).0;
+            }
+        });
+        v
+    }
+
+    /// ∇ of [`LaneRoadField::wall_value`]: w'(g)·sign·(∇d − d_div'·∇s).
+    pub fn wall_gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
+        let mut g = [0.0, 0.0];
+        if self.walls.is_empty() {
+            return g;
+        }
+        self.divider_terms(x_m, y_m, |k, j, delta, slope, _| {
+            if let Some(sign) = self.wall_sign(k) {
+                let clearance = sign * delta - self.half_width_m;
+                let (_, de) = wall_term(self.edge_gain_m2, self.edge_clamp_distance_m, clearance);
+                let w = to_world_gradient(j, -de * sign * slope, de * sign);
+                g[0] += w[0];
+                g[1] += w[1];
+            }
         });
         g
     }
@@ -233,16 +508,27 @@ impl<'g, 'a> LaneRoadField<'g, 'a> {
         out
     }
 
-    /// U_LD + U_RE.
+    /// U_LD + U_RE (+ the lane-end walls).
     pub fn value(&self, x_m: f64, y_m: f64) -> f64 {
-        self.lane_value(x_m, y_m) + self.edge_value(x_m, y_m)
+        self.lane_value(x_m, y_m) + self.edge_value(x_m, y_m) + self.wall_value(x_m, y_m)
     }
 
-    /// ∇(U_LD + U_RE).
+    /// ∇(U_LD + U_RE) (+ the lane-end walls), one frame projection per divider.
     pub fn gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
-        let lane = self.lane_gradient(x_m, y_m);
-        let edge = self.edge_gradient(x_m, y_m);
-        [lane[0] + edge[0], lane[1] + edge[1]]
+        let s2 = self.lane_sigma_m * self.lane_sigma_m;
+        let mut g = self.edge_gradient(x_m, y_m);
+        self.divider_terms(x_m, y_m, |k, j, delta, slope, u| {
+            let mut du_dd = -u * delta / s2;
+            if let Some(sign) = self.wall_sign(k) {
+                let clearance = sign * delta - self.half_width_m;
+                let (_, de) = wall_term(self.edge_gain_m2, self.edge_clamp_distance_m, clearance);
+                du_dd += de * sign;
+            }
+            let w = to_world_gradient(j, -du_dd * slope, du_dd);
+            g[0] += w[0];
+            g[1] += w[1];
+        });
+        g
     }
 }
 

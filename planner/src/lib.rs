@@ -16,6 +16,7 @@ pub mod following;
 pub mod lane_frame;
 mod lane_road_edges;
 pub mod lane_road_field;
+mod lane_road_frames;
 pub mod local_path;
 pub mod min_distance;
 pub mod obstacle_field;

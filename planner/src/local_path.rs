@@ -132,7 +132,8 @@ mod tests {
     #[test]
     fn one_substep_is_eq_7_and_steps_have_length_ls() {
         let params = PlannerParams::default();
-        let road = MergeRoad::default();
+        let merge = MergeRoad::default();
+        let road = crate::lane_road_field::LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = VehicleState {
             x_m: 0.0,
             y_m: 2.3,
@@ -158,7 +159,8 @@ mod tests {
         // bounce (ψ_ref flips between ≈ +0.5 and −1.47 rad).
         use crate::types::Neighbour;
         let params = PlannerParams::default();
-        let road = MergeRoad::default();
+        let merge = MergeRoad::default();
+        let road = crate::lane_road_field::LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = VehicleState {
             x_m: 215.0,
             y_m: 5.85,
@@ -215,7 +217,8 @@ mod tests {
     #[test]
     fn path_relaxes_towards_the_lane_centre() {
         let params = PlannerParams::default();
-        let road = MergeRoad::default();
+        let merge = MergeRoad::default();
+        let road = crate::lane_road_field::LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = VehicleState {
             x_m: 0.0,
             y_m: 2.4,
@@ -224,7 +227,7 @@ mod tests {
         };
         let field = PotentialField::new(&params, &road, 0, &ego, &VehicleShape::default(), &[]);
         let path = local_path(&field, [0.0, 2.4], 5.0, 20, 1.0, 0.0);
-        let centre = road.lane_center_y_m(crate::road::Lane::Lower);
+        let centre = merge.lane_center_y_m(crate::road::Lane::Lower);
         let first_offset = (2.4 - centre).abs();
         let last_offset = (path[19][1] - centre).abs();
         assert!(

@@ -54,8 +54,13 @@ pub struct ObstacleField {
     pub cos_heading: f64,
     /// sin ψ_o.
     pub sin_heading: f64,
-    /// ψ_o (rad), capped for the correlation form.
+    /// ψ_o (rad) relative to the lane at the obstacle (the world yaw on a road along +x),
+    /// capped for the correlation form.
     pub heading_rad: f64,
+    /// (cos, sin) of the lane's heading at the obstacle: the axes the correlation form is
+    /// written in ((1, 0) on a road along +x). The rotation form needs none: its ellipse is
+    /// the obstacle's own frame, which rotates with the map.
+    pub lane_axes: [f64; 2],
     /// σ_x ahead of the obstacle (m).
     pub sigma_front_m: f64,
     /// σ_x behind the obstacle (m).
@@ -98,11 +103,29 @@ impl ObstacleField {
             cos_heading,
             sin_heading,
             heading_rad: cap_heading(heading_rad),
+            lane_axes: [1.0, 0.0],
             sigma_front_m: d.front_m / x_scale,
             sigma_rear_m: d.rear_m / x_scale,
             sigma_lateral_m: params.sigma_lateral_m(),
             amplitude: params.amplitude,
             heading_form: params.heading_form,
+        }
+    }
+
+    /// The same field with its heading taken relative to a lane heading `lane_heading_rad` at
+    /// the obstacle (Eq. 4 on a road of lanes): the correlation form is then written in the
+    /// lane's axes, so a rotated copy of the road gives the same field. A lane along +x
+    /// (heading 0) leaves the field as it is.
+    pub fn in_lane_frame(self, lane_heading_rad: f64) -> Self {
+        if lane_heading_rad == 0.0 {
+            return self;
+        }
+        let (s, c) = lane_heading_rad.sin_cos();
+        let world = self.sin_heading.atan2(self.cos_heading);
+        Self {
+            heading_rad: cap_heading(world - lane_heading_rad),
+            lane_axes: [c, s],
+            ..self
         }
     }
 
@@ -143,7 +166,9 @@ impl ObstacleField {
             y_m,
             cos_heading,
             sin_heading,
-            heading_rad: cap_heading(sin_heading.atan2(cos_heading)),
+            heading_rad: cap_heading(
+                sin_heading.atan2(cos_heading) - self.lane_axes[1].atan2(self.lane_axes[0]),
+            ),
             ..*self
         }
     }
@@ -153,7 +178,9 @@ impl ObstacleField {
         let dx = x_m - self.x_m;
         let along = match self.heading_form {
             HeadingForm::Rotation => self.cos_heading * dx + self.sin_heading * (y_m - self.y_m),
-            HeadingForm::PaperCorrelation => dx,
+            HeadingForm::PaperCorrelation => {
+                self.lane_axes[0] * dx + self.lane_axes[1] * (y_m - self.y_m)
+            }
         };
         if along >= 0.0 {
             Side::Front
@@ -187,11 +214,15 @@ impl ObstacleField {
                 (q, grad, d_sigma)
             }
             HeadingForm::PaperCorrelation => {
+                // In the lane's axes (identity on a road along +x).
+                let [lc, ls] = self.lane_axes;
+                let (dx, dy) = (lc * dx + ls * dy, -ls * dx + lc * dy);
                 let psi = self.heading_rad;
                 let c1 = 1.0 - psi * psi;
                 let (a, b, c) = (1.0 / (sx * sx), 1.0 / (sy * sy), psi / (sx * sy));
                 let q = 0.5 * c1 * (a * dx * dx + b * dy * dy - 2.0 * c * dx * dy);
-                let grad = [c1 * (a * dx - c * dy), c1 * (b * dy - c * dx)];
+                let g = [c1 * (a * dx - c * dy), c1 * (b * dy - c * dx)];
+                let grad = [lc * g[0] - ls * g[1], ls * g[0] + lc * g[1]];
                 // ∂a/∂σ_x = −2/σ_x³, ∂c/∂σ_x = −c/σ_x.
                 let d_sigma = 0.5 * c1 * (-2.0 * dx * dx / (sx * sx * sx) + 2.0 * c * dx * dy / sx);
                 (q, grad, d_sigma)

@@ -4,7 +4,7 @@
 //! Each other vehicle comes with a [`Trajectory`]: its received shared local path (PF-ISO, if
 //! fresh) or a prediction from its perceived state (`PlannerParams::prediction`; PF-ISO-PRED and
 //! PF-SP always, PF-ISO for a vehicle without a fresh SLP), and whether it is ahead of the
-//! planning vehicle *now* (larger X along the road).
+//! planning vehicle *now* (larger s along the ego's lane).
 //!
 //! Roles (who keeps the gap) shape each other vehicle's field:
 //! - a received SLP is the sender's declared intent: with `interaction_rear_only` the roles are
@@ -19,12 +19,13 @@
 
 use std::collections::BTreeMap;
 
+use crate::lane_road_field::LaneRoadGeometry;
+use crate::obstacle_field::HeadingForm;
 use crate::obstacle_field::{ObstacleField, ObstacleFieldParams, Role, SelfView};
 use crate::params::PlannerParams;
 use crate::planners::PlanRequest;
 use crate::polyline::Polyline;
 use crate::prediction::{PredictionModel, Trajectory};
-use crate::road::MergeRoad;
 use crate::speed_optimisation::fixed_waypoint_term::SlotOther;
 use crate::speed_optimisation::{Aggregate, FixedWaypointTerm, InteractionTerm};
 use crate::types::{SharedLocalPath, VehicleId, VehicleShape};
@@ -40,7 +41,7 @@ pub struct Other {
     pub speed_mps: f64,
     /// Its shape.
     pub shape: VehicleShape,
-    /// Whether it is ahead of the planning vehicle now (larger X).
+    /// Whether it is ahead of the planning vehicle now (larger s along the ego's lane).
     pub ahead_now: bool,
 }
 
@@ -72,23 +73,28 @@ pub fn has_fresh_shared_path(params: &PlannerParams, req: &PlanRequest<'_>) -> b
 }
 
 /// The others, by id: received SLPs if `use_shared_paths` (PF-ISO), then a prediction with
-/// `model` for every perceived neighbour without one.
+/// `model` for every perceived neighbour without one. "Ahead" is measured along the frame of
+/// the ego's lane (larger s).
 pub fn gather_others(
     params: &PlannerParams,
-    road: &MergeRoad,
+    road: &LaneRoadGeometry,
     req: &PlanRequest<'_>,
     use_shared_paths: bool,
     model: PredictionModel,
 ) -> Vec<Other> {
     let mut others: BTreeMap<VehicleId, Other> = BTreeMap::new();
+    let ego_p = [req.ego.x_m, req.ego.y_m];
+    let ego_lane = road.lane_index_at(ego_p);
+    let ego_s_m = road.s_m(ego_lane, ego_p);
+    let ahead = |p: [f64; 2]| road.s_m(ego_lane, p) > ego_s_m;
     if use_shared_paths {
         for (id, m) in fresh_shared_paths(params, req) {
             let perceived = req.neighbours.iter().find(|n| n.id == id);
             let yaw = perceived.map_or(0.0, |n| n.state.yaw_rad);
-            let x_now_m = perceived
-                .map(|n| n.state.x_m)
-                .or_else(|| m.waypoints.first().map(|w| w.x_m))
-                .unwrap_or(req.ego.x_m);
+            let p_now_m = perceived
+                .map(|n| [n.state.x_m, n.state.y_m])
+                .or_else(|| m.waypoints.first().map(|w| [w.x_m, w.y_m]))
+                .unwrap_or(ego_p);
             if let Some(trajectory) = Trajectory::from_shared(m, yaw) {
                 others.insert(
                     id,
@@ -97,7 +103,7 @@ pub fn gather_others(
                         trajectory,
                         speed_mps: m.speed_mps,
                         shape: m.shape,
-                        ahead_now: x_now_m > req.ego.x_m,
+                        ahead_now: ahead(p_now_m),
                     },
                 );
             }
@@ -114,7 +120,7 @@ pub fn gather_others(
                 trajectory: model.trajectory(n.state, req.time_s, road),
                 speed_mps: n.state.speed_mps,
                 shape: n.shape,
-                ahead_now: n.state.x_m > req.ego.x_m,
+                ahead_now: ahead([n.state.x_m, n.state.y_m]),
             },
         );
     }
@@ -170,6 +176,21 @@ fn base_field(
     field.with_role(role_of(rules, other), contact_m, field_params.x_scale())
 }
 
+/// `base` moved to a pose; for the correlation form of Eq. 4 its heading is taken relative to
+/// the lane at the pose (the rotation form needs no lane: its ellipse is the vehicle's frame).
+fn moved_in_lane(
+    base: &ObstacleField,
+    road: &LaneRoadGeometry,
+    xy_m: [f64; 2],
+    heading: [f64; 2],
+) -> ObstacleField {
+    let moved = base.moved_to(xy_m[0], xy_m[1], heading[0], heading[1]);
+    match moved.heading_form {
+        HeadingForm::Rotation => moved,
+        HeadingForm::PaperCorrelation => moved.in_lane_frame(road.lane_heading_at_rad(xy_m)),
+    }
+}
+
 /// Absolute time of slot i (1-based): t_0 + i·Δt_plan.
 fn slot_time_s(params: &PlannerParams, req: &PlanRequest<'_>, i: usize) -> f64 {
     req.time_s + i as f64 * params.step_time_s
@@ -177,6 +198,7 @@ fn slot_time_s(params: &PlannerParams, req: &PlanRequest<'_>, i: usize) -> f64 {
 
 /// The arc-length term (module doc of `speed_optimisation::interaction_term`): the others'
 /// fields at their poses at each slot time, against the ego's position along `line`.
+#[allow(clippy::too_many_arguments)] // the term's inputs, each used once
 pub fn arc_length_term(
     params: &PlannerParams,
     field_params: &ObstacleFieldParams,
@@ -185,6 +207,7 @@ pub fn arc_length_term(
     req: &PlanRequest<'_>,
     others: &[Other],
     line: &Polyline,
+    road: &LaneRoadGeometry,
 ) -> InteractionTerm {
     let n = params.waypoint_count;
     let bases: Vec<(ObstacleField, &Trajectory)> = others
@@ -198,7 +221,7 @@ pub fn arc_length_term(
                 .iter()
                 .map(|(base, trajectory)| {
                     let pose = trajectory.pose_at(t_s);
-                    base.moved_to(pose.xy_m[0], pose.xy_m[1], pose.heading[0], pose.heading[1])
+                    moved_in_lane(base, road, pose.xy_m, pose.heading)
                 })
                 .collect()
         })
@@ -221,6 +244,7 @@ pub fn fixed_waypoint_term(
     req: &PlanRequest<'_>,
     others: &[Other],
     waypoints: &[[f64; 2]],
+    road: &LaneRoadGeometry,
 ) -> FixedWaypointTerm {
     let field_params = params.interaction_field();
     let bases: Vec<(ObstacleField, &Other)> = others
@@ -237,12 +261,7 @@ pub fn fixed_waypoint_term(
                 .map(|(base, other)| {
                     let pose = other.trajectory.pose_at(t_s);
                     SlotOther {
-                        field: base.moved_to(
-                            pose.xy_m[0],
-                            pose.xy_m[1],
-                            pose.heading[0],
-                            pose.heading[1],
-                        ),
+                        field: moved_in_lane(base, road, pose.xy_m, pose.heading),
                         speed_mps: other.trajectory.speed_at(t_s),
                         shape: other.shape,
                         role: role_of(rules, other),

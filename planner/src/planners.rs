@@ -23,7 +23,8 @@ use serde::{Deserialize, Serialize};
 use crate::cubic_fit::{FitMethod, fit_path_cubic};
 use crate::error::PlannerError;
 use crate::fallback::{FallbackInput, fallback_plan};
-use crate::following::{V2vLossFallback, following_cap_mps};
+use crate::following::{V2vLossFallback, following_cap_in_lane_frame_mps};
+use crate::lane_road_field::LaneRoadGeometry;
 use crate::local_path::local_path_adaptive;
 use crate::others::{
     RoleRules, arc_length_term, fixed_waypoint_term, gather_others, has_fresh_shared_path,
@@ -32,11 +33,12 @@ use crate::params::{PlannerParams, SlpReading};
 use crate::polyline::Polyline;
 use crate::potential_field::{GridSpec, PotentialField};
 pub use crate::request::{PlanRequest, validate_request};
-use crate::road::MergeRoad;
 use crate::speed_optimisation::{
     Aggregate, SpeedOptimiser, SpeedProblem, SpeedTerm, friction_speed_limits,
 };
 use crate::types::{FallbackReason, PathPoint, Plan, SharedLocalPath};
+use mergesim_types::lanes::LaneRoad;
+use std::sync::Arc;
 
 /// Which planner a vehicle runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -127,10 +129,14 @@ pub struct PlanStats {
 pub struct PfPlanner {
     kind: PlannerKind,
     params: PlannerParams,
-    road: MergeRoad,
+    /// The road as lanes, prepared once (`lane_road_field.rs`), shareable between planners.
+    road: Arc<LaneRoadGeometry>,
     last_good: Option<Plan>,
     optimiser: SpeedOptimiser,
     stats: PlanStats,
+    /// The lane (index) the vehicle was settled in at its last cycle, for the lane-end rule's
+    /// walls (`LaneRoadGeometry::lane_end_walls`).
+    settled_lane: Option<usize>,
     /// Time of the first planning cycle (s): V2V counts as lost only once a shared path could
     /// have arrived (`max_shared_path_age_s` after it).
     first_plan_s: Option<f64>,
@@ -155,18 +161,34 @@ struct CycleFailure {
 }
 
 impl PfPlanner {
-    /// A planner of `kind`; fails if the parameters or the road are invalid.
+    /// A planner of `kind` on the road `lanes` (a [`LaneRoad`], or one shared through an
+    /// `Arc`: the simulator passes the road its observations carry, `Observation::lanes`);
+    /// its geometry is prepared here, once. Fails if the parameters are invalid (a
+    /// [`LaneRoad`] is valid once built).
     pub fn new(
         kind: PlannerKind,
         params: PlannerParams,
-        road: MergeRoad,
+        lanes: impl Into<Arc<LaneRoad>>,
+    ) -> Result<Self, PlannerError> {
+        Self::on_geometry(
+            kind,
+            params,
+            Arc::new(LaneRoadGeometry::shared(lanes.into())),
+        )
+    }
+
+    /// A planner of `kind` on a road already prepared (several planners can share one).
+    pub fn on_geometry(
+        kind: PlannerKind,
+        params: PlannerParams,
+        road: Arc<LaneRoadGeometry>,
     ) -> Result<Self, PlannerError> {
         params.validate()?;
-        road.validate()?;
         Ok(Self {
             kind,
             params,
             road,
+            settled_lane: None,
             last_good: None,
             optimiser: SpeedOptimiser::new(),
             stats: PlanStats::default(),
@@ -184,8 +206,18 @@ impl PfPlanner {
         &self.params
     }
 
-    /// The road.
-    pub fn road(&self) -> &MergeRoad {
+    /// The road, as lanes.
+    pub fn road(&self) -> &LaneRoad {
+        self.road.road()
+    }
+
+    /// The road, shared (to build another planner on it).
+    pub fn shared_road(&self) -> Arc<LaneRoad> {
+        self.road.shared_road().clone()
+    }
+
+    /// The road's prepared geometry, shared (to build another planner on it).
+    pub fn road_geometry(&self) -> &Arc<LaneRoadGeometry> {
         &self.road
     }
 
@@ -200,15 +232,21 @@ impl PfPlanner {
     }
 
     /// The universal field of the request's ego (Eq. 5).
+    /// The lane-end rule's walls are those of the last cycle's settled lane.
     pub fn field<'s>(&'s self, req: &PlanRequest<'_>) -> PotentialField<'s> {
-        PotentialField::new(
+        let mut field = PotentialField::new(
             &self.params,
             &self.road,
             req.ego_id,
             &req.ego,
             &req.ego_shape,
             req.neighbours,
-        )
+        );
+        field.road.walls = self
+            .road
+            .lane_end_walls(&req.ego, 0.5 * req.ego_shape.width_m, self.settled_lane)
+            .0;
+        field
     }
 
     /// Universal potential U at (x, y) seen by the ego of `req` (for drawing the field). It
@@ -300,6 +338,7 @@ impl PfPlanner {
                 req,
                 &others,
                 line,
+                &self.road,
             ))
         } else {
             let rules = RoleRules {
@@ -317,16 +356,22 @@ impl PfPlanner {
                     req,
                     &others,
                     line,
+                    &self.road,
                 )),
-                SlpReading::FixedWaypoints => {
-                    Box::new(fixed_waypoint_term(params, rules, req, &others, waypoints))
-                }
+                SlpReading::FixedWaypoints => Box::new(fixed_waypoint_term(
+                    params, rules, req, &others, waypoints, &self.road,
+                )),
             }
         };
         (Some(term), weight, count)
     }
 
     fn plan_cycle(&mut self, req: &PlanRequest<'_>) -> Result<Plan, CycleFailure> {
+        // The lane-end rule's walls: settled in a lane that goes on, now or at the last cycle.
+        let (walls, settled_lane) =
+            self.road
+                .lane_end_walls(&req.ego, 0.5 * req.ego_shape.width_m, self.settled_lane);
+        self.settled_lane = settled_lane;
         let params = &self.params;
         let n = params.waypoint_count;
         let fail = |error: PlannerError, waypoints: Option<Vec<[f64; 2]>>| CycleFailure {
@@ -335,7 +380,7 @@ impl PfPlanner {
         };
 
         // Eqs. 1–7: waypoints by gradient steps.
-        let field = PotentialField::new(
+        let mut field = PotentialField::new(
             params,
             &self.road,
             req.ego_id,
@@ -343,6 +388,7 @@ impl PfPlanner {
             &req.ego_shape,
             req.neighbours,
         );
+        field.road.walls = walls;
         let step_m = params.step_length_m(req.ego.speed_mps);
         let time_per_step_s = if params.predict_obstacles_in_path {
             params.step_time_s
@@ -422,8 +468,9 @@ impl PfPlanner {
                     }
                 }
                 if degraded
-                    && let Some(cap_mps) = following_cap_mps(
+                    && let Some(cap_mps) = following_cap_in_lane_frame_mps(
                         params,
+                        &self.road,
                         req.ego_id,
                         &req.ego,
                         &req.ego_shape,

@@ -1,12 +1,16 @@
 //! The universal potential field U_uni = U_AT + U_LD + U_RE + Σ_j U_OB^j and its force
 //! F_uni = −∇U_uni (paper Eq. 5), plus sampling on a grid for drawing.
+//!
+//! The road terms live in the lane frame (`lane_road_field.rs`, planner/README.md "The road
+//! terms in the lane frame"): Eq. 1 pulls along the target lane's centreline (the vehicle's own
+//! lane, or the lane it must merge into when its own ends: the lane-end rule), Eqs. 2–3 are the
+//! dividers and the drivable area's outer edges, and each obstacle's Eq. 4 heading is taken
+//! relative to its lane.
 
-use crate::attractive_field::AttractiveField;
 use crate::error::PlannerError;
+use crate::lane_road_field::{LaneRoadField, LaneRoadGeometry};
 use crate::obstacle_field::{ObstacleField, SelfView};
 use crate::params::PlannerParams;
-use crate::road::MergeRoad;
-use crate::road_field::RoadField;
 use crate::types::{Neighbour, VehicleId, VehicleShape, VehicleState};
 
 pub use mergesim_types::{GridSpec, MAX_GRID_CELLS};
@@ -14,12 +18,16 @@ pub use mergesim_types::{GridSpec, MAX_GRID_CELLS};
 /// The universal field seen by one planning vehicle at one planning instant.
 #[derive(Clone, Debug)]
 pub struct PotentialField<'a> {
-    /// Eq. 1 with the target a look-ahead ahead of the vehicle.
-    pub attractive: AttractiveField,
+    /// λ of Eq. 1 (1/m²).
+    pub attractive_gain_per_m2: f64,
     /// Look-ahead of the moving target (m).
     pub lookahead_m: f64,
-    /// Eqs. 2–3.
-    pub road: RoadField<'a>,
+    /// The target lane of Eq. 1 (index into the road's lanes).
+    pub target_lane: usize,
+    /// s_tar on the target lane for the drawn (fixed-target) field: the ego's s + look-ahead.
+    pub target_s_m: f64,
+    /// Eqs. 2–3 (with the lane-end rule's walls).
+    pub road: LaneRoadField<'a>,
     /// Eq. 4, one per other vehicle, in the order of the neighbours given.
     pub obstacles: Vec<ObstacleField>,
     /// Each obstacle's velocity (m/s), for [`PotentialField::stepping_force_at`].
@@ -30,7 +38,7 @@ impl<'a> PotentialField<'a> {
     /// The field of vehicle `ego_id` at `ego` among `neighbours` (its own entry is skipped).
     pub fn new(
         params: &PlannerParams,
-        road: &'a MergeRoad,
+        road: &'a LaneRoadGeometry,
         ego_id: VehicleId,
         ego: &VehicleState,
         ego_shape: &VehicleShape,
@@ -61,29 +69,47 @@ impl<'a> PotentialField<'a> {
                     n.state.speed_mps,
                     &n.shape,
                 )
+                .in_lane_frame(road.lane_heading_at_rad([n.state.x_m, n.state.y_m]))
             })
             .collect();
+        let ego_p = [ego.x_m, ego.y_m];
+        let target_lane = road.target_lane(road.lane_index_at(ego_p));
         Self {
-            attractive: AttractiveField {
-                gain_per_m2: params.attractive_gain_per_m2,
-                target_x_m: ego.x_m + params.target_lookahead_m,
-            },
+            attractive_gain_per_m2: params.attractive_gain_per_m2,
             lookahead_m: params.target_lookahead_m,
-            road: RoadField {
-                road,
-                lane_amplitude: params.lane_amplitude,
-                lane_sigma_m: params.lane_sigma_m,
-                edge_gain_m2: params.edge_gain_m2,
-                edge_clamp_distance_m: params.edge_clamp_distance_m,
-                half_width_m: 0.5 * ego_shape.width_m,
-            },
+            target_lane,
+            target_s_m: road.s_m(target_lane, ego_p) + params.target_lookahead_m,
+            road: LaneRoadField::for_vehicle(road, params, 0.5 * ego_shape.width_m, ego),
             obstacles,
             obstacle_velocities_mps,
         }
     }
 
+    /// U_AT at (x, y), Eq. 1 with the target fixed at the ego's s + look-ahead on the target
+    /// lane: ½ λ (s − s_tar)².
+    pub fn attractive_value(&self, x_m: f64, y_m: f64) -> f64 {
+        let ds = self.road.geometry.s_m(self.target_lane, [x_m, y_m]) - self.target_s_m;
+        0.5 * self.attractive_gain_per_m2 * ds * ds
+    }
+
+    /// ∇U_AT = λ (s − s_tar) ∇s (fixed target).
+    pub fn attractive_gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
+        let j = self.road.geometry.jacobian(self.target_lane, [x_m, y_m]);
+        let k = self.attractive_gain_per_m2 * (j.frame.s_m - self.target_s_m);
+        [k * j.grad_s[0], k * j.grad_s[1]]
+    }
+
+    /// ∇U_AT with the target re-anchored a look-ahead ahead of (x, y) along the target lane
+    /// (Eq. 1, reading 1): −λ·look-ahead·∇s (on a straight road along +x the constant
+    /// [−λ·look-ahead, 0]).
+    pub fn moving_target_gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
+        let j = self.road.geometry.jacobian(self.target_lane, [x_m, y_m]);
+        let k = -self.attractive_gain_per_m2 * self.lookahead_m;
+        [k * j.grad_s[0], k * j.grad_s[1]]
+    }
+
     /// U_LD + U_RE + Σ U_OB: everything but the attraction (what a drawing usually wants:
-    /// the attraction is a bowl of size ½ λ Δx² that swamps the rest).
+    /// the attraction is a bowl of size ½ λ Δs² that swamps the rest).
     pub fn repulsive_value(&self, x_m: f64, y_m: f64) -> f64 {
         self.road.value(x_m, y_m)
             + self
@@ -93,9 +119,9 @@ impl<'a> PotentialField<'a> {
                 .sum::<f64>()
     }
 
-    /// U_uni (Eq. 5) with the target fixed at ego X + look-ahead.
+    /// U_uni (Eq. 5) with the target fixed at the ego's s + look-ahead.
     pub fn value(&self, x_m: f64, y_m: f64) -> f64 {
-        self.attractive.value(x_m) + self.repulsive_value(x_m, y_m)
+        self.attractive_value(x_m, y_m) + self.repulsive_value(x_m, y_m)
     }
 
     /// ∇(U_LD + U_RE + Σ U_OB).
@@ -109,19 +135,20 @@ impl<'a> PotentialField<'a> {
         g
     }
 
-    /// ∇U_uni with the target fixed at ego X + look-ahead.
+    /// ∇U_uni with the target fixed at the ego's s + look-ahead.
     pub fn gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
         let mut g = self.repulsive_gradient(x_m, y_m);
-        g[0] += self.attractive.gradient(x_m)[0];
+        let a = self.attractive_gradient(x_m, y_m);
+        g[0] += a[0];
+        g[1] += a[1];
         g
     }
 
     /// F_uni = −∇U_uni (Eq. 5) with the moving target of Eq. 1 (a constant pull
-    /// λ·look-ahead along +X): the force that steps the local path (Eqs. 6–7).
+    /// λ·look-ahead along the target lane): the force that steps the local path (Eqs. 6–7).
     pub fn stepping_force(&self, x_m: f64, y_m: f64) -> [f64; 2] {
         let g = self.repulsive_gradient(x_m, y_m);
-        let pull =
-            AttractiveField::moving_target_gradient(self.attractive.gain_per_m2, self.lookahead_m);
+        let pull = self.moving_target_gradient(x_m, y_m);
         [-(g[0] + pull[0]), -(g[1] + pull[1])]
     }
 
@@ -138,8 +165,7 @@ impl<'a> PotentialField<'a> {
             g[0] += go[0];
             g[1] += go[1];
         }
-        let pull =
-            AttractiveField::moving_target_gradient(self.attractive.gain_per_m2, self.lookahead_m);
+        let pull = self.moving_target_gradient(x_m, y_m);
         [-(g[0] + pull[0]), -(g[1] + pull[1])]
     }
 
@@ -182,7 +208,8 @@ mod tests {
     #[test]
     fn universal_gradient_matches_central_differences() {
         let params = PlannerParams::default();
-        let road = MergeRoad::default();
+        let merge = crate::road::MergeRoad::default();
+        let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let neighbours = [
             Neighbour {
                 id: 1,
@@ -234,11 +261,12 @@ mod tests {
     #[test]
     fn default_lane_equilibria_sit_at_the_lane_centres() {
         let params = PlannerParams::default();
-        let road = MergeRoad::default();
+        let merge = crate::road::MergeRoad::default();
+        let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = state(0.0, 1.75, 0.0, 20.0);
         let field = PotentialField::new(&params, &road, 0, &ego, &VehicleShape::default(), &[]);
         for lane in [crate::road::Lane::Lower, crate::road::Lane::Upper] {
-            let centre = road.lane_center_y_m(lane);
+            let centre = merge.lane_center_y_m(lane);
             let fy = |y: f64| field.stepping_force(50.0, y)[1];
             let (mut lo, mut hi) = (centre - 0.6, centre + 0.6);
             assert!(fy(lo) > 0.0 && fy(hi) < 0.0, "restoring on both sides");
@@ -253,7 +281,8 @@ mod tests {
     #[test]
     fn own_entry_among_neighbours_is_skipped() {
         let params = PlannerParams::default();
-        let road = MergeRoad::default();
+        let merge = crate::road::MergeRoad::default();
+        let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = state(0.0, 1.75, 0.0, 20.0);
         let neighbours = [Neighbour {
             id: 7,
@@ -274,7 +303,8 @@ mod tests {
     #[test]
     fn grid_samples_cell_centres_row_after_row() {
         let params = PlannerParams::default();
-        let road = MergeRoad::default();
+        let merge = crate::road::MergeRoad::default();
+        let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = state(0.0, 1.75, 0.0, 20.0);
         let field = PotentialField::new(&params, &road, 0, &ego, &VehicleShape::default(), &[]);
         let spec = GridSpec {

@@ -5,7 +5,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::road::MergeRoad;
+use std::sync::Arc;
+
+use mergesim_types::lanes::{LaneRoad, Side};
+
+use crate::lane_road_field::LaneRoadGeometry;
 use crate::types::{SharedLocalPath, TimedWaypoint, VehicleState};
 
 /// How a vehicle without a fresh shared path is predicted.
@@ -15,22 +19,131 @@ pub enum PredictionModel {
     /// Straight along its current heading at its current speed. A car 0.02 rad off the road
     /// axis is predicted 3.2 m — a lane — off its lane after 160 m.
     ConstantVelocity,
-    /// Along the road at its current speed, keeping its lateral position; in the ending lane
-    /// it is lifted to stay half a lane above the tapering edge, so a merging car is predicted
-    /// to merge where the lane ends.
+    /// Along its lane at its current speed, keeping its lateral offset d in the lane frame;
+    /// in a lane that ends it is lifted to stay half the lane's starting width inside the
+    /// closing bound, so a merging car is predicted to merge where the lane ends.
     LaneFollowing,
 }
 
 impl PredictionModel {
-    /// The prediction of a vehicle in `state` at `time_s`.
-    pub fn trajectory(self, state: VehicleState, time_s: f64, road: &MergeRoad) -> Trajectory {
+    /// The prediction of a vehicle in `state` at `time_s` on `road`.
+    pub fn trajectory(
+        self,
+        state: VehicleState,
+        time_s: f64,
+        road: &LaneRoadGeometry,
+    ) -> Trajectory {
         match self {
             PredictionModel::ConstantVelocity => Trajectory::ConstantVelocity { state, time_s },
-            PredictionModel::LaneFollowing => Trajectory::LaneFollowing {
-                state,
-                time_s,
-                road: road.clone(),
+            PredictionModel::LaneFollowing => {
+                Trajectory::LaneFollowing(LaneFollowing::new(state, time_s, road))
+            }
+        }
+    }
+}
+
+/// A vehicle predicted along its lane (the `lane-following` model) in the lane frame.
+#[derive(Clone, Debug)]
+pub struct LaneFollowing {
+    /// State at `time_s`.
+    pub state: VehicleState,
+    /// Time of the state (s).
+    pub time_s: f64,
+    road: Arc<LaneRoad>,
+    /// Index of its lane in the road.
+    lane: usize,
+    /// (s, d) now in its lane's frame (m).
+    s0_m: f64,
+    d0_m: f64,
+    /// ds/dt per unit speed at its offset: 1/(1 − κ d) (1 on a straight lane).
+    ds_per_m: f64,
+    /// The closing bound of its lane if that ends (the side away from the lane it merges into),
+    /// and half the lane's starting width (m).
+    lift: Option<(Side, f64)>,
+    /// The tangent of a straight lane (its pose is then the state moved along it, exactly).
+    straight_tangent: Option<[f64; 2]>,
+}
+
+impl PartialEq for LaneFollowing {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.road, &other.road)
+            && self.state == other.state
+            && self.time_s == other.time_s
+            && self.lane == other.lane
+    }
+}
+
+impl LaneFollowing {
+    /// The prediction of a vehicle in `state` at `time_s` on `road`.
+    pub fn new(state: VehicleState, time_s: f64, road: &LaneRoadGeometry) -> Self {
+        let p = [state.x_m, state.y_m];
+        let (lane, fp) = road.lane_at(p);
+        let l = &road.road().lanes()[lane];
+        let q = 1.0 - l.curvature_1pm(fp.s_m) * fp.d_m;
+        let ds_per_m = if q > 0.1 { 1.0 / q } else { 10.0 };
+        let lift = if road.lane_ends(lane) {
+            let target = road.target_lane(lane);
+            road.side_of_neighbour(lane, target).map(|side| {
+                let closing = match side {
+                    Side::Left => Side::Right,
+                    Side::Right => Side::Left,
+                };
+                (closing, 0.5 * l.width_m(0.0))
+            })
+        } else {
+            None
+        };
+        Self {
+            state,
+            time_s,
+            road: road.shared_road().clone(),
+            lane,
+            s0_m: fp.s_m,
+            d0_m: fp.d_m,
+            ds_per_m,
+            lift,
+            straight_tangent: road.straight_tangent(lane),
+        }
+    }
+
+    /// Pose at absolute time `t_s`.
+    pub fn pose_at(&self, t_s: f64) -> PredictedPose {
+        let travelled_m = self.state.speed_mps * (t_s - self.time_s);
+        let l = &self.road.lanes()[self.lane];
+        let s_m = self.s0_m + travelled_m * self.ds_per_m;
+        // Lifted by the closing bound: d and its slope along s.
+        let lifted = self.lift.and_then(|(side, half_m)| {
+            let (bound, slope) = l.bound_d_and_slope(side, s_m);
+            match side {
+                Side::Right => (bound + half_m > self.d0_m).then_some((bound + half_m, slope)),
+                Side::Left => (bound - half_m < self.d0_m).then_some((bound - half_m, slope)),
+            }
+        });
+        match (lifted, self.straight_tangent) {
+            (None, Some(t)) => PredictedPose {
+                xy_m: [
+                    self.state.x_m + travelled_m * t[0],
+                    self.state.y_m + travelled_m * t[1],
+                ],
+                heading: t,
             },
+            (lifted, _) => {
+                let (d_m, slope) = lifted.unwrap_or((self.d0_m, 0.0));
+                let axes = l.centreline().axes(s_m, d_m);
+                let dir = [
+                    axes.dp_ds[0] + slope * axes.dp_dd[0],
+                    axes.dp_ds[1] + slope * axes.dp_dd[1],
+                ];
+                let norm = dir[0].hypot(dir[1]);
+                PredictedPose {
+                    xy_m: axes.point_m,
+                    heading: if norm > 0.0 {
+                        [dir[0] / norm, dir[1] / norm]
+                    } else {
+                        [1.0, 0.0]
+                    },
+                }
+            }
         }
     }
 }
@@ -62,16 +175,9 @@ pub enum Trajectory {
         /// Time of the state (s).
         time_s: f64,
     },
-    /// Along the road (+X) at the current speed, lateral position kept, but at least half a
-    /// lane above the lower edge where the ending lane tapers.
-    LaneFollowing {
-        /// State at `time_s`.
-        state: VehicleState,
-        /// Time of the state (s).
-        time_s: f64,
-        /// The road it follows.
-        road: MergeRoad,
-    },
+    /// Along its lane at the current speed, lateral offset kept, but at least half a lane
+    /// inside the closing bound of a lane that ends.
+    LaneFollowing(LaneFollowing),
 }
 
 impl Trajectory {
@@ -106,9 +212,8 @@ impl Trajectory {
     /// prediction, the speed of the segment of a shared path.
     pub fn speed_at(&self, t_s: f64) -> f64 {
         match self {
-            Self::ConstantVelocity { state, .. } | Self::LaneFollowing { state, .. } => {
-                state.speed_mps
-            }
+            Self::ConstantVelocity { state, .. } => state.speed_mps,
+            Self::LaneFollowing(f) => f.state.speed_mps,
             Self::Shared { waypoints, .. } => {
                 let n = waypoints.len();
                 if n < 2 {
@@ -127,28 +232,7 @@ impl Trajectory {
     /// Pose at absolute time `t_s`.
     pub fn pose_at(&self, t_s: f64) -> PredictedPose {
         match self {
-            Self::LaneFollowing {
-                state,
-                time_s,
-                road,
-            } => {
-                let x_m = state.x_m + state.speed_mps * (t_s - time_s);
-                let half_lane_m = 0.5 * road.lane_width_m;
-                let lifted_y_m = road.lower_edge_y_m(x_m) + half_lane_m;
-                if state.y_m < road.y_lane_m() && lifted_y_m > state.y_m {
-                    let slope = road.lower_edge_slope(x_m);
-                    let norm = slope.hypot(1.0);
-                    PredictedPose {
-                        xy_m: [x_m, lifted_y_m],
-                        heading: [1.0 / norm, slope / norm],
-                    }
-                } else {
-                    PredictedPose {
-                        xy_m: [x_m, state.y_m],
-                        heading: [1.0, 0.0],
-                    }
-                }
-            }
+            Self::LaneFollowing(f) => f.pose_at(t_s),
             Self::ConstantVelocity { state, time_s } => {
                 let (s, c) = state.yaw_rad.sin_cos();
                 let d = state.speed_mps * (t_s - time_s);
@@ -237,7 +321,8 @@ mod tests {
 
     #[test]
     fn lane_following_keeps_the_lane_and_merges_with_the_taper() {
-        let road = MergeRoad::default();
+        let road = crate::road::MergeRoad::default();
+        let geometry = LaneRoadGeometry::new(&road.lane_road().unwrap());
         // An upper-lane car slightly yawed: stays at its lateral position along the road.
         let upper = VehicleState {
             x_m: 0.0,
@@ -245,7 +330,7 @@ mod tests {
             yaw_rad: 0.03,
             speed_mps: 15.0,
         };
-        let t = PredictionModel::LaneFollowing.trajectory(upper, 2.0, &road);
+        let t = PredictionModel::LaneFollowing.trajectory(upper, 2.0, &geometry);
         let pose = t.pose_at(10.0);
         assert_eq!(pose.xy_m, [120.0, 5.3]);
         assert_eq!(pose.heading, [1.0, 0.0]);
@@ -259,7 +344,7 @@ mod tests {
             yaw_rad: 0.0,
             speed_mps: 20.0,
         };
-        let t = PredictionModel::LaneFollowing.trajectory(lower, 0.0, &road);
+        let t = PredictionModel::LaneFollowing.trajectory(lower, 0.0, &geometry);
         assert_eq!(t.pose_at(2.0).xy_m[1], lower.y_m);
         let mid_x = 0.5 * (road.merge_start_x_m + road.merge_end_x_m);
         let mid = t.pose_at((mid_x - 100.0) / 20.0);

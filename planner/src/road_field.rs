@@ -1,4 +1,7 @@
-//! Road potential field: lane divider (paper Eq. 2) and road edges (Eq. 3).
+//! Road potential field: lane divider (paper Eq. 2) and road edges (Eq. 3) on the straight
+//! `MergeRoad`, in X and Y. The planners use the lane-frame field (`lane_road_field.rs`); this
+//! one is the reference the tests and the `lane_road_field` bench compare it with, and
+//! `edge_term` (e(g) and e'(g)) is shared by both.
 //!
 //! Readings of the paper (listed in `planner/README.md`):
 //! - Eq. 3 writes ½ ξ (1/(Y − Y_{l,u} − l_w/2))² for both edges; we use the clearance

@@ -32,7 +32,12 @@ fn request<'a>(
 }
 
 fn planner(kind: PlannerKind) -> PfPlanner {
-    PfPlanner::new(kind, PlannerParams::default(), MergeRoad::default()).unwrap()
+    PfPlanner::new(
+        kind,
+        PlannerParams::default(),
+        MergeRoad::default().lane_road().unwrap(),
+    )
+    .unwrap()
 }
 
 /// The simulator may run vehicles or Monte-Carlo runs on other threads.
@@ -128,7 +133,12 @@ fn curvature_caps_the_speed_in_a_bend() {
         cubic_max_heading_rad: 0.02,
         ..PlannerParams::default()
     };
-    let mut p = PfPlanner::new(PlannerKind::PfSp, tight, MergeRoad::default()).unwrap();
+    let mut p = PfPlanner::new(
+        PlannerKind::PfSp,
+        tight,
+        MergeRoad::default().lane_road().unwrap(),
+    )
+    .unwrap();
     let plan = p.plan(&req).unwrap();
     assert!(plan.fallback.is_none());
     let params = p.params().clone();
@@ -268,7 +278,7 @@ fn a_follower_does_not_push_the_leader_when_the_follower_is_responsible() {
             roles_from_order_now: from_order_now,
             ..PlannerParams::default()
         };
-        let plan = PfPlanner::new(kind, params, MergeRoad::default())
+        let plan = PfPlanner::new(kind, params, MergeRoad::default().lane_road().unwrap())
             .unwrap()
             .plan(&request(ego, 15.0, &neighbours, &[]))
             .unwrap();
@@ -337,7 +347,12 @@ fn solver_failure_returns_a_flagged_comfortable_deceleration() {
         solver_max_iterations: 0,
         ..PlannerParams::default()
     };
-    let mut p = PfPlanner::new(PlannerKind::PfIso, params.clone(), MergeRoad::default()).unwrap();
+    let mut p = PfPlanner::new(
+        PlannerKind::PfIso,
+        params.clone(),
+        MergeRoad::default().lane_road().unwrap(),
+    )
+    .unwrap();
     let ego = state(50.0, 1.75, 0.0, 20.0);
     let plan = p.plan(&request(ego, 20.0, &[], &[])).unwrap();
     let Some(FallbackReason::SolverFailed(text)) = &plan.fallback else {
@@ -499,10 +514,14 @@ fn pf_sp_brakes_for_risk_ahead_and_never_races() {
     };
     let ego = state(100.0, 5.25, 0.0, 15.0);
     let plan = |neighbours: &[Neighbour]| {
-        PfPlanner::new(PlannerKind::PfSp, PlannerParams::default(), road.clone())
-            .unwrap()
-            .plan(&request(ego, 15.0, neighbours, &[]))
-            .unwrap()
+        PfPlanner::new(
+            PlannerKind::PfSp,
+            PlannerParams::default(),
+            road.lane_road().unwrap(),
+        )
+        .unwrap()
+        .plan(&request(ego, 15.0, neighbours, &[]))
+        .unwrap()
     };
     let first_speed = |p: &Plan| p.path[1].speed_mps;
     let alone = plan(&[]);
@@ -531,7 +550,7 @@ fn pf_sp_brakes_for_risk_ahead_and_never_races() {
     let eq10 = PfPlanner::new(
         PlannerKind::PfSpEq10,
         PlannerParams::default(),
-        road.clone(),
+        road.lane_road().unwrap(),
     )
     .unwrap()
     .plan(&request(ego, 15.0, &slow_ahead, &[]))

@@ -40,7 +40,7 @@ proptest! {
         let mut shared = Vec::new();
         if with_shared {
             for n in &neighbours {
-                let mut p = PfPlanner::new(PlannerKind::PfSp, params.clone(), road.clone()).unwrap();
+                let mut p = PfPlanner::new(PlannerKind::PfSp, params.clone(), road.lane_road().unwrap()).unwrap();
                 let req = PlanRequest {
                     time_s: 1.0, ego_id: n.id, ego: n.state, ego_shape: shape,
                     target_speed_mps: 15.0, mu, neighbours: &[], shared_paths: &[],
@@ -52,7 +52,7 @@ proptest! {
             time_s: 1.0, ego_id: 0, ego, ego_shape: shape, target_speed_mps: target, mu,
             neighbours: &neighbours, shared_paths: &shared,
         };
-        let mut planner = PfPlanner::new(kind, params.clone(), road).unwrap();
+        let mut planner = PfPlanner::new(kind, params.clone(), road.lane_road().unwrap()).unwrap();
         for _ in 0..2 {
             let plan = planner.plan(&req).unwrap();
             prop_assert_eq!(plan.path.len(), params.waypoint_count + 1);

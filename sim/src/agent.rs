@@ -41,8 +41,13 @@ pub fn behaviour_of(
     spec: &VehicleSpec,
     registry: &BehaviourRegistry,
     planner_override: Option<&str>,
+    lanes: &std::sync::Arc<mergesim_types::lanes::LaneRoad>,
 ) -> Result<Box<dyn Behaviour>, SimError> {
-    let input = FactoryInput { config, spec };
+    let input = FactoryInput {
+        config,
+        spec,
+        lanes,
+    };
     Ok(match &spec.driver {
         Driver::Planner(name) => registry.create(planner_override.unwrap_or(name), &input)?,
         Driver::Prescribed {
@@ -70,7 +75,7 @@ impl Agent {
     /// at (s = x_m, d = y_offset_m) of its start lane, heading along the lane.
     pub fn spawn(
         config: &SimConfig,
-        lanes: &LaneRoad,
+        lanes: &std::sync::Arc<LaneRoad>,
         physics: &mut vehicles::PhysicsWorld,
         index: usize,
         spec: &VehicleSpec,
@@ -97,7 +102,7 @@ impl Agent {
         };
         let vehicle = Vehicle::spawn(physics, &params, x_m, y_m, yaw_rad, spec.speed_mps)?;
         let shape = vehicle.shape(VehicleShape::default().max_brake_decel_mps2);
-        let behaviour = behaviour_of(config, spec, registry, planner_override)?;
+        let behaviour = behaviour_of(config, spec, registry, planner_override, lanes)?;
         let tracker = Tracker::new(config.tracker.clone(), &params);
         Ok(Self {
             id: index as VehicleId,

@@ -48,6 +48,8 @@ pub struct FactoryInput<'a> {
     pub config: &'a SimConfig,
     /// The vehicle.
     pub spec: &'a VehicleSpec,
+    /// The road as lanes, built once per world (the road every `Observation::lanes` carries).
+    pub lanes: &'a Arc<mergesim_types::lanes::LaneRoad>,
 }
 
 /// Builds a behaviour for one vehicle.
@@ -72,16 +74,12 @@ impl std::fmt::Debug for BehaviourRegistry {
 /// The factory of a potential-field planner of `kind`.
 fn pf_factory(kind: PlannerKind) -> BehaviourFactory {
     Arc::new(move |input: &FactoryInput<'_>| {
-        PfPlanner::new(
-            kind,
-            input.config.planner.clone(),
-            input.config.road.clone(),
-        )
-        .map(|p| Box::new(p) as Box<dyn Behaviour>)
-        .map_err(|source| SimError::Planner {
-            vehicle: input.spec.name.clone(),
-            source,
-        })
+        PfPlanner::new(kind, input.config.planner.clone(), Arc::clone(input.lanes))
+            .map(|p| Box::new(p) as Box<dyn Behaviour>)
+            .map_err(|source| SimError::Planner {
+                vehicle: input.spec.name.clone(),
+                source,
+            })
     })
 }
 

@@ -32,7 +32,7 @@ pub fn following(
 ) -> (f64, f64, f64) {
     let road = single_lane_road();
     let shape = VehicleShape::default();
-    let mut planner = PfPlanner::new(kind, params.clone(), road.clone()).unwrap();
+    let mut planner = PfPlanner::new(kind, params.clone(), road.lane_road().unwrap()).unwrap();
     let y_m = road.lane_center_y_m(planner::Lane::Upper);
     let mut follower = VehicleState {
         x_m: 100.0,
@@ -157,7 +157,8 @@ pub fn lateral_equilibrium_m(params: &PlannerParams, neighbour: Option<(f64, f64
         })
         .into_iter()
         .collect();
-    let field = planner::PotentialField::new(params, &road, 0, &ego, &shape, &neighbours);
+    let geometry = planner::lane_road_field::LaneRoadGeometry::new(&road.lane_road().unwrap());
+    let field = planner::PotentialField::new(params, &geometry, 0, &ego, &shape, &neighbours);
     let fy = |y: f64| field.stepping_force(100.0, y)[1];
     let (mut lo, mut hi) = (centre - 1.0, centre + 1.0);
     assert!(fy(lo) > 0.0 && fy(hi) < 0.0, "restoring on both sides");
@@ -178,7 +179,7 @@ pub fn first_planned_speed_mps(
 ) -> f64 {
     let road = MergeRoad::default();
     let shape = VehicleShape::default();
-    let mut planner = PfPlanner::new(kind, params.clone(), road.clone()).unwrap();
+    let mut planner = PfPlanner::new(kind, params.clone(), road.lane_road().unwrap()).unwrap();
     let ego = VehicleState {
         x_m: 20.0,
         y_m: road.lane_center_y_m(planner::Lane::Lower),
