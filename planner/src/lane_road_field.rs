@@ -377,17 +377,22 @@ impl<'g> LaneRoadField<'g> {
         }
     }
 
-    /// The field of a vehicle in `state`, with the lane-end rule's walls
-    /// ([`LaneRoadGeometry::lane_end_walls`] without a previous cycle: walls only if the vehicle
-    /// is settled now): [`wall_term`] along each, in d − d_div(s).
+    /// The field of a vehicle in `state`, with the lane-end rule's walls when
+    /// `params.lane_end_walls` ([`LaneRoadGeometry::lane_end_walls`] without a previous cycle:
+    /// walls only if the vehicle is settled now): [`wall_term`] along each, in d − d_div(s).
     pub fn for_vehicle(
         geometry: &'g LaneRoadGeometry,
         params: &PlannerParams,
         half_width_m: f64,
         state: &VehicleState,
     ) -> Self {
+        let walls = if params.lane_end_walls {
+            geometry.lane_end_walls(state, half_width_m, None).0
+        } else {
+            Vec::new()
+        };
         Self {
-            walls: geometry.lane_end_walls(state, half_width_m, None).0,
+            walls,
             ..Self::new(geometry, params, half_width_m)
         }
     }

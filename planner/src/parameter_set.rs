@@ -12,6 +12,7 @@
 //! | `obstacle_min_distance_by_side` | false | true | ahead of a slower car the printed D_min is the clamp: the faster car may cut in at contact distance |
 //! | `obstacle_time_gap_s` | 0 | 2 s | two cars at equal speed may follow bumper to bumper |
 //! | `predict_obstacles_in_path` | false | true | a path stepped against where the others are *now* meets a leader's field head-on and flips sides from cycle to cycle |
+//! | `lane_end_walls` | false | true | a car beside the ending lane can be pushed into it by another's field (the lane-end rule) |
 //! | `max_substep_m`, `substep_max_turn_rad` | one step per waypoint | 1 m, adaptive | an 8 m step jumps the 1 m wide divider ridge and bounces off the edge's wall |
 //! | `interaction_slp_reading` | `fixed-waypoints` | `arc-length` | speed enters only through D_min(v): the term cannot tell where a slower car will be |
 //! | `interaction_time_gap_s` | 0 | 2 s | as the path field's |
@@ -64,6 +65,7 @@ impl ParameterSet {
                 obstacle_min_distance_by_side: false,
                 obstacle_time_gap_s: 0.0,
                 predict_obstacles_in_path: false,
+                lane_end_walls: false,
                 // One gradient step per waypoint for any L_s below 1 km (Eq. 7 as printed).
                 max_substep_m: 1000.0,
                 substep_max_turn_rad: 0.0,

@@ -108,6 +108,11 @@ pub struct PlannerParams {
     /// occupies now but will have left when the ego arrives (docs/reproduction.md,
     /// "Calibration").
     pub predict_obstacles_in_path: bool,
+    /// The lane-end rule's walls: a vehicle settled in a lane that goes on sees the divider
+    /// towards a lane that ends ahead as an edge (Eq. 3's term, `LaneRoadGeometry::lane_end_walls`),
+    /// so the field of a car beside it cannot push it into a lane that is about to close. The
+    /// paper has no such rule (`false`: only Eq. 2's soft divider term). On by default.
+    pub lane_end_walls: bool,
     /// Longest sub-step of the gradient integration inside one waypoint step (m). The paper's
     /// Eq. 7 is one sub-step per waypoint; shorter sub-steps follow the force's stream line
     /// instead of zig-zagging over the divider ridge when L_s is several metres.
@@ -285,6 +290,7 @@ impl Default for PlannerParams {
             substep_max_turn_rad: 0.1,
             // Obstacles where they will be, not where they are (see the field doc).
             predict_obstacles_in_path: true,
+            lane_end_walls: true,
             cubic_origin_weight: 10.0,
             cubic_max_offset_m: 0.5,
             cubic_max_heading_rad: 0.35,

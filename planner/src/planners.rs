@@ -242,10 +242,12 @@ impl PfPlanner {
             &req.ego_shape,
             req.neighbours,
         );
-        field.road.walls = self
-            .road
-            .lane_end_walls(&req.ego, 0.5 * req.ego_shape.width_m, self.settled_lane)
-            .0;
+        if self.params.lane_end_walls {
+            field.road.walls = self
+                .road
+                .lane_end_walls(&req.ego, 0.5 * req.ego_shape.width_m, self.settled_lane)
+                .0;
+        }
         field
     }
 
@@ -368,9 +370,12 @@ impl PfPlanner {
 
     fn plan_cycle(&mut self, req: &PlanRequest<'_>) -> Result<Plan, CycleFailure> {
         // The lane-end rule's walls: settled in a lane that goes on, now or at the last cycle.
-        let (walls, settled_lane) =
+        let (walls, settled_lane) = if self.params.lane_end_walls {
             self.road
-                .lane_end_walls(&req.ego, 0.5 * req.ego_shape.width_m, self.settled_lane);
+                .lane_end_walls(&req.ego, 0.5 * req.ego_shape.width_m, self.settled_lane)
+        } else {
+            (Vec::new(), None)
+        };
         self.settled_lane = settled_lane;
         let params = &self.params;
         let n = params.waypoint_count;

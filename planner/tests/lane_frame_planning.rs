@@ -348,3 +348,30 @@ fn every_planner_merges_on_the_curved_road_and_stays_in_lane() {
         );
     }
 }
+
+/// The lane-end rule's walls are a `mergesim` improvement: a car settled in the through lane
+/// beside the ending lane sees the divider as a wall with `lane_end_walls` (the `mergesim` set)
+/// and only Eq. 2's soft divider term without (the `paper` set).
+#[test]
+fn the_lane_end_walls_are_on_in_the_mergesim_set_and_off_in_the_paper_set() {
+    let road = Arc::new(LaneRoad::new(&MergeRoad::default().lane_road_spec()).unwrap());
+    let through = index_of(&road, THROUGH_LANE_ID);
+    let car = on_lane(&road, through, 100.0, 0.0, 0.0, 20.0);
+    let walls = |set: ParameterSet| {
+        let planner =
+            PfPlanner::new(PlannerKind::PfIso, set.planner_params(), road.clone()).unwrap();
+        let req = PlanRequest {
+            time_s: 0.0,
+            ego_id: 0,
+            ego: car,
+            ego_shape: VehicleShape::default(),
+            target_speed_mps: 20.0,
+            mu: 0.8,
+            neighbours: &[],
+            shared_paths: &[],
+        };
+        planner.field(&req).road.walls.len()
+    };
+    assert_eq!(walls(ParameterSet::Mergesim), 1);
+    assert_eq!(walls(ParameterSet::Paper), 0);
+}
