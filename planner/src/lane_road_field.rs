@@ -33,7 +33,7 @@ use std::sync::Arc;
 use mergesim_types::lanes::{Centreline, Divider, FramePoint, Lane, LaneId, LaneRoad, Side};
 
 use crate::lane_frame::{FrameJacobian, frame_jacobian, to_world_gradient};
-use crate::lane_road_edges::EdgeGeometry;
+use crate::lane_road_edges::{EdgeDistance, EdgeGeometry};
 use crate::lane_road_frames::{BoundOffset, FastFrame};
 use crate::params::PlannerParams;
 use crate::road_field::edge_term;
@@ -486,14 +486,39 @@ impl<'g> LaneRoadField<'g> {
             x_m - self.geometry.origin_m[0],
             y_m - self.geometry.origin_m[1],
         ];
+        let mut drivable = None;
         self.geometry
             .edges
             .iter()
             .map(|e| {
-                let g = e.distance(q).distance_m - self.half_width_m;
+                let d = self.on_road_distance(e, q, [x_m, y_m], &mut drivable);
+                let g = d.distance_m - self.half_width_m;
                 edge_term(self.edge_gain_m2, self.edge_clamp_distance_m, g).0
             })
             .sum()
+    }
+
+    /// The signed distance to edge `e` (local point `q`, world point `p_m`), positive on its
+    /// drivable side — and positive on any drivable point: an edge bounds its own lanes, and a
+    /// point of another lane beyond it (the main road seen across the gore from a ramp's left
+    /// bound) is not off the road. Whether `p_m` is drivable is asked only when some edge
+    /// gives a negative distance, once per point (`drivable` caches it).
+    #[inline]
+    fn on_road_distance(
+        &self,
+        e: &EdgeGeometry,
+        q: [f64; 2],
+        p_m: [f64; 2],
+        drivable: &mut Option<bool>,
+    ) -> EdgeDistance {
+        let mut d = e.distance(q);
+        if d.distance_m < 0.0
+            && *drivable.get_or_insert_with(|| self.geometry.road().is_drivable(p_m))
+        {
+            d.distance_m = -d.distance_m;
+            d.gradient = [-d.gradient[0], -d.gradient[1]];
+        }
+        d
     }
 
     /// ∇U_RE = Σ_k e'(g_k) ∇δ_k.
@@ -503,8 +528,9 @@ impl<'g> LaneRoadField<'g> {
             y_m - self.geometry.origin_m[1],
         ];
         let mut out = [0.0, 0.0];
+        let mut drivable = None;
         for e in &self.geometry.edges {
-            let d = e.distance(q);
+            let d = self.on_road_distance(e, q, [x_m, y_m], &mut drivable);
             let g = d.distance_m - self.half_width_m;
             let (_, de) = edge_term(self.edge_gain_m2, self.edge_clamp_distance_m, g);
             out[0] += de * d.gradient[0];

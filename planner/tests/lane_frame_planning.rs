@@ -375,3 +375,36 @@ fn the_lane_end_walls_are_on_in_the_mergesim_set_and_off_in_the_paper_set() {
     assert_eq!(walls(ParameterSet::Mergesim), 1);
     assert_eq!(walls(ParameterSet::Paper), 0);
 }
+
+/// On the on-ramp road the ramp's left bound is an outer edge whose far side, across the gore,
+/// is the main road: a car on the main road is on the road, not beyond that edge. (Before the
+/// edge distance was made positive on every drivable point, the ramp's edge pushed a car in
+/// the main road's right lane towards the gore until its waypoints stopped advancing at the
+/// acceleration lane's start, and every planner fell back from t = 0 on the `on_ramp` built-in.)
+#[test]
+fn a_car_on_the_main_road_beside_an_on_ramp_keeps_its_lane() {
+    use mergesim_types::lanes::{LaneId, OnRampParams, on_ramp_spec};
+    let road = Arc::new(LaneRoad::new(&on_ramp_spec(&OnRampParams::default()).unwrap()).unwrap());
+    let right_main = index_of(&road, LaneId(2));
+    for kind in PlannerKind::ALL {
+        let mut planner = PfPlanner::new(kind, PlannerParams::default(), road.clone()).unwrap();
+        let car = on_lane(&road, right_main, 120.0, 0.0, 0.0, 15.0);
+        let plan = planner
+            .plan(&PlanRequest {
+                time_s: 0.0,
+                ego_id: 0,
+                ego: car,
+                ego_shape: VehicleShape::default(),
+                target_speed_mps: 15.0,
+                mu: 0.8,
+                neighbours: &[],
+                shared_paths: &[],
+            })
+            .unwrap();
+        assert_eq!(plan.fallback, None, "{kind}");
+        for p in &plan.path {
+            let d = road.lanes()[right_main].project([p.x_m, p.y_m]).d_m;
+            assert!(d.abs() < 0.3, "{kind}: planned point {p:?} at d = {d:.2} m");
+        }
+    }
+}
