@@ -206,6 +206,33 @@ fn lane_ids_are_drawn_on_request() {
     assert!(stderr(&out).contains("--plots"), "{}", stderr(&out));
 }
 
+/// The GIF draws the scenario's own road: `curved_merge`'s 300 m-radius curve makes the whole-
+/// road view taller than wide (the straight `[sim.road]` it also carries is a thin strip; the
+/// CLI drew that one until it asked the scenario for its lanes).
+#[test]
+fn the_gif_draws_the_scenarios_road_of_lanes() {
+    let dir = scratch("gif_curved");
+    let gif = dir.join("curved.gif");
+    let out = merge_sim(&[
+        "run",
+        "--scenario",
+        "curved_merge",
+        "--no-rrd",
+        "--quiet",
+        "--gif",
+        gif.to_str().unwrap(),
+        "--gif-fps",
+        "1",
+        "--gif-view",
+        "road",
+        "--gif-width",
+        "300",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (_, w, h, _, _) = decode_gif(&gif);
+    assert!(h > w, "{w} x {h} px: the curve is not drawn");
+}
+
 #[test]
 fn bad_follow_and_gif_options_are_refused_before_the_run() {
     let dir = scratch("gif_bad");

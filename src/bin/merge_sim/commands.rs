@@ -267,7 +267,7 @@ fn write_run_gif(
         }
     };
     // The road as lanes (the world's own road: `World` builds its lanes the same way).
-    let lanes = instance.sim.road.lane_road().map_err(input)?;
+    let lanes = instance.sim.lanes().map_err(input)?;
     let stats = write_gif(
         path,
         &lanes,
@@ -350,12 +350,7 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
             })
             .collect();
         // The road as lanes, as the world builds it from the scenario's road.
-        let lanes = scenario
-            .instance(args.seed)
-            .sim
-            .road
-            .lane_road()
-            .map_err(input)?;
+        let lanes = scenario.instance(args.seed).sim.lanes().map_err(input)?;
         let written = mergesim::plots::write_comparison(
             dir,
             &lanes,
