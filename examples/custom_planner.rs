@@ -1,9 +1,10 @@
 //! Adding your own planner without editing any crate: implement `Behaviour`, register it by
 //! name, select it in a scenario, run.
 //!
-//! The planner here is a simple adaptive cruise control (ACC) for the through lane: it keeps its
-//! lane and its target speed, but never closes in on a vehicle ahead in its lane (or merging
-//! into it) faster than a constant time gap allows. It broadcasts its path, so the PF-ISO ego
+//! The planner here is a simple adaptive cruise control (ACC) on any road of lanes: it keeps the
+//! lane it is in (its centreline, through `Observation::lanes`) and its target speed, but never
+//! closes in on a vehicle ahead in its lane (or within a metre of entering it) faster than a
+//! constant time gap allows. It broadcasts its path, so the PF-ISO ego
 //! sees where it is going. The example runs the paper's urgent merge with the obstacle driven by
 //! this ACC against the ego's PF-ISO and prints the run summary.
 //!
@@ -15,8 +16,8 @@ use mergesim::experiment::{InstanceOptions, run_instance};
 use mergesim::scenarios::Scenario;
 use mergesim::sim::recording::Recorder;
 use mergesim::sim::{
-    Behaviour, BehaviourError, BehaviourRegistry, Decision, Driver, FactoryInput, Lane,
-    Observation, PathPoint, SharedLocalPath,
+    Behaviour, BehaviourError, BehaviourRegistry, Decision, Driver, FactoryInput, Observation,
+    PathPoint, SharedLocalPath,
 };
 
 /// Constant-time-gap cruise control along the through lane.
@@ -29,18 +30,23 @@ struct TimeGapCruise {
 
 impl Behaviour for TimeGapCruise {
     fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError> {
-        let lane_y_m = obs.road.lane_center_y_m(Lane::Upper);
-        // The nearest vehicle ahead that is in the through lane or within a metre of entering it.
-        let lower_edge_of_lane = obs.road.y_lane_m() - 1.0;
+        // The lane the car is in, and where along it (s, d) the car and the others are.
+        let here = obs.lanes.nearest_lane([obs.ego.x_m, obs.ego.y_m]);
+        let Some(lane) = obs.lanes.lane(here.lane) else {
+            return Err("the car is on no lane".into());
+        };
+        let half_width_m = 0.5 * lane.width_m(here.frame.s_m);
+        // The nearest vehicle ahead that is in this lane or within a metre of entering it.
         let ahead = obs
             .neighbours
             .iter()
-            .filter(|n| n.state.x_m > obs.ego.x_m && n.state.y_m > lower_edge_of_lane)
-            .min_by(|a, b| a.state.x_m.total_cmp(&b.state.x_m));
+            .map(|n| (n, lane.project([n.state.x_m, n.state.y_m])))
+            .filter(|(_, f)| f.s_m > here.frame.s_m && f.d_m.abs() < half_width_m + 1.0)
+            .min_by(|a, b| a.1.s_m.total_cmp(&b.1.s_m));
         let speed_mps = match ahead {
-            Some(n) => {
+            Some((n, f)) => {
                 let gap_m =
-                    n.state.x_m - obs.ego.x_m - 0.5 * (n.shape.length_m + obs.ego_shape.length_m);
+                    f.s_m - here.frame.s_m - 0.5 * (n.shape.length_m + obs.ego_shape.length_m);
                 let keeps_gap_mps = (gap_m - self.min_gap_m).max(0.0) / self.time_gap_s;
                 obs.target_speed_mps
                     .min(keeps_gap_mps.max(n.state.speed_mps.min(obs.target_speed_mps)))
@@ -48,12 +54,18 @@ impl Behaviour for TimeGapCruise {
             None => obs.target_speed_mps,
         }
         .max(0.5);
+        // Points along the lane's centreline (its frame continues straight past its end).
         let path: Vec<PathPoint> = (0..=20)
             .map(|i| {
                 let ahead_m = 4.0 * i as f64;
+                let [x_m, y_m] = if i == 0 {
+                    [obs.ego.x_m, obs.ego.y_m]
+                } else {
+                    lane.point(here.frame.s_m + ahead_m, 0.0)
+                };
                 PathPoint {
-                    x_m: obs.ego.x_m + ahead_m,
-                    y_m: lane_y_m,
+                    x_m,
+                    y_m,
                     speed_mps,
                     t_s: obs.time_s + ahead_m / speed_mps,
                 }

@@ -19,15 +19,24 @@ struct FixedSpeed {
 
 impl Behaviour for FixedSpeed {
     fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError> {
-        let y_m = obs.road.lane_center_y_m(self.lane);
+        // Its spawn lane as a lane of the road (the merge road's lanes by their ids).
+        let id = match self.lane {
+            Lane::Upper => mergesim::sim::lanes::THROUGH_LANE_ID,
+            Lane::Lower => mergesim::sim::lanes::ENDING_LANE_ID,
+        };
+        let lane = obs.lanes.lane(id).ok_or("no such lane")?;
+        let s_m = lane.project([obs.ego.x_m, obs.ego.y_m]).s_m;
         let v = self.speed_mps;
         Ok(Decision::follow(
             (0..=20)
-                .map(|i| PathPoint {
-                    x_m: obs.ego.x_m + 3.0 * i as f64,
-                    y_m,
-                    speed_mps: v,
-                    t_s: obs.time_s + 3.0 * i as f64 / v,
+                .map(|i| {
+                    let [x_m, y_m] = lane.point(s_m + 3.0 * i as f64, 0.0);
+                    PathPoint {
+                        x_m,
+                        y_m,
+                        speed_mps: v,
+                        t_s: obs.time_s + 3.0 * i as f64 / v,
+                    }
                 })
                 .collect(),
         ))

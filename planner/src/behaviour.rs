@@ -69,7 +69,6 @@ mod tests {
             ego_shape: VehicleShape::default(),
             target_speed_mps: 20.0,
             mu: 0.8,
-            road: &road,
             lanes: &road.lane_road().unwrap(),
             neighbours: &[],
             shared_paths: &[],

@@ -29,6 +29,9 @@ pub mod world;
 
 pub use config::{Driver, SimConfig, VehicleSpec, validate_vehicles};
 pub use error::SimError;
+/// Roads made of lanes (what `Observation::lanes` is): re-exported for planners written against
+/// the simulator.
+pub use mergesim_types::lanes;
 pub use mergesim_types::{
     Behaviour, BehaviourError, Decision, GridSpec, Lane, MergeRoad, Neighbour, Observation,
     OptimiserReport, PathPoint, SharedLocalPath, TimedWaypoint, VehicleId, VehicleShape,

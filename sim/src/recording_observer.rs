@@ -14,14 +14,45 @@ fn rec(e: RecordingError) -> SimError {
 
 /// The field window: 120 m of road from 20 m behind the vehicle, the whole road's width, 0.5 m
 /// cells.
-fn field_grid(x_m: f64, road: &mergesim_types::MergeRoad) -> GridSpec {
+/// Length of the recorded field's window along x: 20 m behind the ego to 100 m ahead (m).
+const FIELD_BEHIND_M: f64 = 20.0;
+const FIELD_AHEAD_M: f64 = 100.0;
+/// Spacing of the bound samples that find the road's lateral extent in the window (m).
+const FIELD_BOUND_SAMPLE_M: f64 = 2.0;
+/// At most this many rows (a 200 m tall window at 0.5 m): a road crossing the window steeply.
+const FIELD_MAX_ROWS: usize = 400;
+
+/// The grid the potential field is recorded on: 0.5 m cells, x from 20 m behind the ego to
+/// 100 m ahead, y over the lanes' bounds within that x window (on the straight merge road its
+/// bottom to top edge, as before; on a curve as far as the road reaches across the window).
+fn field_grid(x_m: f64, y_m: f64, lanes: &mergesim_types::lanes::LaneRoad) -> GridSpec {
+    use mergesim_types::lanes::Side;
     let cell_m = 0.5;
+    let (x_lo, x_hi) = (x_m - FIELD_BEHIND_M, x_m + FIELD_AHEAD_M);
+    let (mut y_lo, mut y_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for lane in lanes.lanes() {
+        let length_m = lane.length_m();
+        let samples = (length_m / FIELD_BOUND_SAMPLE_M).ceil().max(1.0) as usize;
+        for k in 0..=samples {
+            let s_m = length_m * k as f64 / samples as f64;
+            for side in [Side::Left, Side::Right] {
+                let [px, py] = lane.point(s_m, lane.bound_d_m(side, s_m));
+                if (x_lo..=x_hi).contains(&px) {
+                    y_lo = y_lo.min(py);
+                    y_hi = y_hi.max(py);
+                }
+            }
+        }
+    }
+    if !(y_lo.is_finite() && y_hi.is_finite() && y_hi > y_lo) {
+        (y_lo, y_hi) = (y_m - 5.0, y_m + 5.0);
+    }
     GridSpec {
-        x_min_m: x_m - 20.0,
-        y_min_m: road.y_bottom_m,
+        x_min_m: x_lo,
+        y_min_m: y_lo,
         cell_m,
-        columns: 240,
-        rows: ((road.y_upper_m() - road.y_bottom_m) / cell_m).ceil() as usize,
+        columns: ((x_hi - x_lo) / cell_m).round() as usize,
+        rows: (((y_hi - y_lo) / cell_m).ceil() as usize).min(FIELD_MAX_ROWS),
     }
 }
 
@@ -67,7 +98,11 @@ impl TickObserver for RecordingObserver {
         let Some(recorder) = self.enabled() else {
             return Ok(());
         };
-        let spec = field_grid(plan.observation.ego.x_m, plan.observation.road);
+        let spec = field_grid(
+            plan.observation.ego.x_m,
+            plan.observation.ego.y_m,
+            plan.observation.lanes,
+        );
         if let Some(values) = (plan.field)(&spec) {
             recorder
                 .log_field(

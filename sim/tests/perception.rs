@@ -34,7 +34,13 @@ impl Behaviour for Witness {
         let path: Vec<PathPoint> = (0..=20)
             .map(|i| PathPoint {
                 x_m: obs.ego.x_m + 3.0 * i as f64,
-                y_m: obs.road.lane_center_y_m(Lane::Upper),
+                y_m: obs
+                    .lanes
+                    .lane(mergesim_types::lanes::THROUGH_LANE_ID)
+                    .map_or(obs.ego.y_m, |l| {
+                        let s_m = l.project([obs.ego.x_m, obs.ego.y_m]).s_m;
+                        l.point(s_m, 0.0)[1]
+                    }),
                 speed_mps: v,
                 t_s: obs.time_s + 3.0 * i as f64 / v,
             })

@@ -29,7 +29,6 @@
 use crate::grid::GridSpec;
 use crate::lanes::LaneRoad;
 use crate::path::{PathPoint, SharedLocalPath};
-use crate::road::MergeRoad;
 use crate::vehicle::{Neighbour, VehicleId, VehicleShape, VehicleState};
 
 /// Why a behaviour could not plan (its own error, boxed).
@@ -50,9 +49,6 @@ pub struct Observation<'a> {
     pub target_speed_mps: f64,
     /// Tire–road friction μ.
     pub mu: f64,
-    /// The road's parametric description (the paper's straight merge road) that [`Self::lanes`]
-    /// was built from. Being replaced by `lanes` in every consumer; read `lanes` in new code.
-    pub road: &'a MergeRoad,
     /// The road as lanes: centrelines with their (s, d) frames, bounds, links, dividers, outer
     /// edges and lane ends. Planners, metrics and safety checks read the road through it.
     pub lanes: &'a LaneRoad,

@@ -45,7 +45,6 @@ impl World {
             .collect();
         let field_due = self.step_index.is_multiple_of(self.steps_per_field);
         // The observation borrows these while the world records events.
-        let road = self.config.road.clone();
         let lanes = std::sync::Arc::clone(&self.lanes);
         let mu = self.config.mu;
         let mut broadcasts: Vec<(usize, SharedLocalPath)> = Vec::new();
@@ -82,7 +81,6 @@ impl World {
             ego_shape: agent.shape,
             target_speed_mps: agent.spec.target_speed_mps,
             mu,
-            road: &road,
             lanes: &lanes,
             neighbours: &inputs[index].0,
             shared_paths: &inputs[index].1,
