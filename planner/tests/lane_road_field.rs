@@ -367,17 +367,29 @@ fn an_ending_lane_closes_with_an_edge() {
     let p = PlannerParams::default();
     let field = LaneRoadField::new(&geometry, &p, half_width_m());
     let len = accel.length_m();
+    // Eq. 3 measures the distance to the nearest point of each edge: the end is the nearest
+    // part of the drivable area's edge within half a lane width (1.75 m) of it. There the field
+    // grows towards the end and pushes back along the lane.
     let mut last = 0.0;
-    for before in [30.0, 10.0, 5.0, 3.0, 2.0, 1.5, 1.0, 0.5] {
+    for before in [1.5, 1.0, 0.5] {
         let [x, y] = accel.point(len - before, 0.0);
         let v = field.edge_value(x, y);
         assert!(v > last, "{before} m before the end: {v} ≤ {last}");
-        // The end pushes back along the lane.
         assert!(
             field.edge_gradient(x, y)[0] > 0.0,
             "{before} m before the end"
         );
         last = v;
+    }
+    // Farther back the lane's side bound is nearer than its end, and no edge pushes along the
+    // lane: in particular no edge beyond the gore, whose far side is the drivable main road.
+    // (Until an edge's distance was made positive on every drivable point, the main road's
+    // right edge, "beyond" which this point lay, pushed it along x with the linear
+    // continuation's slope, whatever its distance, and this test asserted that push.)
+    for before in [30.0, 10.0, 5.0] {
+        let [x, y] = accel.point(len - before, 0.0);
+        let along = field.edge_gradient(x, y)[0];
+        assert!(along.abs() < 1e-6, "{before} m before the end: {along}");
     }
     // Beyond the end: off the drivable area, the distance to the closed end is negative.
     let [x, y] = accel.point(len + 0.5, 0.0);
