@@ -28,7 +28,9 @@ pub fn read_file(path: &Path) -> Result<Scenario, CommonRoadError> {
         element: None,
         kind,
     };
-    let bytes = std::fs::metadata(path).map_err(|e| at(ErrorKind::Io(e)))?.len();
+    let bytes = std::fs::metadata(path)
+        .map_err(|e| at(ErrorKind::Io(e)))?
+        .len();
     if bytes > MAX_FILE_BYTES {
         return Err(at(ErrorKind::TooLarge {
             bytes,

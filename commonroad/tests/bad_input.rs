@@ -51,7 +51,10 @@ fn unknown_lanelet_reference_names_line_and_lanelet() {
     assert_eq!(e.line, Some(6));
     assert_eq!(e.element.as_deref(), Some("lanelet 1"));
     let msg = e.to_string();
-    assert!(msg.contains("bad.xml:6: lanelet 1:") && msg.contains("lanelet 7"), "{msg}");
+    assert!(
+        msg.contains("bad.xml:6: lanelet 1:") && msg.contains("lanelet 7"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -73,7 +76,10 @@ fn bounds_with_different_point_counts_are_refused() {
 #[test]
 fn unsupported_version_is_refused() {
     let e = read(&doc("2017a", &lanelet(1, 0.0, "")));
-    assert!(matches!(e.kind, ErrorKind::UnsupportedVersion { .. }), "{e}");
+    assert!(
+        matches!(e.kind, ErrorKind::UnsupportedVersion { .. }),
+        "{e}"
+    );
     assert_eq!(e.line, Some(2));
     assert!(e.to_string().contains("2017a"));
 }
@@ -95,9 +101,9 @@ fn too_many_lanelets_are_refused() {
 fn too_many_obstacles_are_refused() {
     let mut body = lanelet(1, 0.0, "");
     for i in 0..=MAX_OBSTACLES {
-        let _ = write!(
+        let _ = writeln!(
             body,
-            "  <staticObstacle id=\"{}\"><type>parkedVehicle</type><shape><rectangle><length>4</length><width>2</width></rectangle></shape><initialState><position><point><x>1</x><y>1</y></point></position><orientation><exact>0</exact></orientation><time><exact>0</exact></time></initialState></staticObstacle>\n",
+            "  <staticObstacle id=\"{}\"><type>parkedVehicle</type><shape><rectangle><length>4</length><width>2</width></rectangle></shape><initialState><position><point><x>1</x><y>1</y></point></position><orientation><exact>0</exact></orientation><time><exact>0</exact></time></initialState></staticObstacle>",
             100 + i
         );
     }

@@ -42,7 +42,10 @@ fn us101_is_read() {
             center_m: [0.0, 0.0]
         }
     );
-    assert_eq!(o.initial_state.position, Some(Position::Point([20.8465, -38.8751])));
+    assert_eq!(
+        o.initial_state.position,
+        Some(Position::Point([20.8465, -38.8751]))
+    );
     assert_eq!(o.initial_state.velocity_mps, Some(Value::Exact(16.322)));
     let second = o.trajectory[1].replay(s.time_step_s).unwrap();
     assert_eq!(second.position_m, [23.3306, -41.1123]);
@@ -52,10 +55,25 @@ fn us101_is_read() {
     let pp = &s.planning_problems[0];
     assert_eq!(pp.id, 458);
     assert_eq!(pp.initial_state.position, Some(Position::Point([0.0, 0.0])));
-    assert_eq!(pp.initial_state.orientation_rad, Some(Value::Exact(-0.76501)));
+    assert_eq!(
+        pp.initial_state.orientation_rad,
+        Some(Value::Exact(-0.76501))
+    );
     let goal = &pp.goal_states[0];
-    assert_eq!(goal.time_step, Some(Value::Interval { start: 90.0, end: 100.0 }));
-    assert_eq!(goal.velocity_mps, Some(Value::Interval { start: 0.0, end: 3.0 }));
+    assert_eq!(
+        goal.time_step,
+        Some(Value::Interval {
+            start: 90.0,
+            end: 100.0
+        })
+    );
+    assert_eq!(
+        goal.velocity_mps,
+        Some(Value::Interval {
+            start: 0.0,
+            end: 3.0
+        })
+    );
     assert_eq!(
         goal.position,
         Some(Position::Shapes(vec![Shape::Rectangle {
@@ -84,7 +102,13 @@ fn a9_2018b_is_read_with_interval_states() {
     assert_eq!(first.velocity_mps, 0.5 * (27.0069 + 27.5434));
     assert_eq!(first.time_s, 0.2);
     let goal = &s.planning_problems[0].goal_states[0];
-    assert_eq!(goal.time_step, Some(Value::Interval { start: 0.0, end: 30.0 }));
+    assert_eq!(
+        goal.time_step,
+        Some(Value::Interval {
+            start: 0.0,
+            end: 30.0
+        })
+    );
     assert!(goal.position.is_none() && goal.velocity_mps.is_none());
 }
 
@@ -94,7 +118,10 @@ fn bound_error_m(file: &str) -> f64 {
     let mut worst = 0.0_f64;
     for l in &s.lanelets {
         let lane = road.lane(LaneId(l.id as u32)).unwrap();
-        for (side, pts) in [(Side::Left, &l.left_bound_m), (Side::Right, &l.right_bound_m)] {
+        for (side, pts) in [
+            (Side::Left, &l.left_bound_m),
+            (Side::Right, &l.right_bound_m),
+        ] {
             for p in pts {
                 let fp = lane.project(*p);
                 let bound = lane.bound_d_m(side, fp.s_m);
@@ -137,7 +164,11 @@ fn roads_keep_the_file_coordinates() {
     let spec = road::lane_road_spec(&s);
     assert_eq!(spec.lanes.len(), 32);
     assert_eq!(
-        spec.lanes.iter().find(|x| x.id == LaneId(436)).unwrap().left,
+        spec.lanes
+            .iter()
+            .find(|x| x.id == LaneId(436))
+            .unwrap()
+            .left,
         Some(LaneId(438))
     );
 }

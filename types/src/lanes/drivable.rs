@@ -268,7 +268,10 @@ mod tests {
         let mid = f64::from_bits(a.to_bits() + 1);
         let out = true_intervals(&[0.0, a, b, 800.0], &|s| s >= mid);
         assert_eq!(out.len(), 1);
-        assert!(out[0][0] >= a && out[0][0] <= b && out[0][1] == 800.0, "{out:?}");
+        assert!(
+            out[0][0] >= a && out[0][0] <= b && out[0][1] == 800.0,
+            "{out:?}"
+        );
     }
 
     #[test]
