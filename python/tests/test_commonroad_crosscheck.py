@@ -16,8 +16,7 @@ import pathlib
 import subprocess
 
 import pytest
-
-cr_reader = pytest.importorskip("commonroad.common.file_reader")
+from commonroad.common import file_reader as cr_reader  # commonroad-io, pinned in ci.sh
 
 DATA = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data" / "commonroad"
 FILES = sorted(DATA.glob("*.xml"))
