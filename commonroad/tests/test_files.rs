@@ -172,3 +172,39 @@ fn roads_keep_the_file_coordinates() {
         Some(LaneId(438))
     );
 }
+
+#[test]
+fn opposite_direction_lanelets_are_lanes_without_neighbour_links() {
+    // Lanelet 1 drives +x on 0 ≤ y ≤ 3.5; lanelet 2 drives −x on 3.5 ≤ y ≤ 7 (its left bound
+    // is the shared line y = 3.5, as CommonRoad orders bounds by each lanelet's direction).
+    let text = "<commonRoad commonRoadVersion=\"2020a\" timeStepSize=\"0.1\">\n\
+  <lanelet id=\"1\">\n\
+    <leftBound><point><x>0</x><y>3.5</y></point><point><x>50</x><y>3.5</y></point></leftBound>\n\
+    <rightBound><point><x>0</x><y>0</y></point><point><x>50</x><y>0</y></point></rightBound>\n\
+    <adjacentLeft ref=\"2\" drivingDir=\"opposite\"/>\n\
+  </lanelet>\n\
+  <lanelet id=\"2\">\n\
+    <leftBound><point><x>50</x><y>3.5</y></point><point><x>0</x><y>3.5</y></point></leftBound>\n\
+    <rightBound><point><x>50</x><y>7</y></point><point><x>0</x><y>7</y></point></rightBound>\n\
+    <adjacentLeft ref=\"1\" drivingDir=\"opposite\"/>\n\
+  </lanelet>\n\
+</commonRoad>\n";
+    let s = mergesim_commonroad::read_str(Path::new("opposite.xml"), text).unwrap();
+    assert_eq!(
+        s.lanelet(1).unwrap().adjacent_left.unwrap().driving_dir,
+        DrivingDir::Opposite
+    );
+    let spec = road::lane_road_spec(&s);
+    assert!(
+        spec.lanes
+            .iter()
+            .all(|l| l.left.is_none() && l.right.is_none())
+    );
+    let built = mergesim_types::lanes::LaneRoad::new(&spec).unwrap();
+    let lane2 = built.lane(LaneId(2)).unwrap();
+    // Lane 2 runs along −x, and the union of both lanes is drivable across the shared line.
+    assert!((lane2.heading_rad(10.0).abs() - std::f64::consts::PI).abs() < 1e-9);
+    assert!(built.is_drivable([25.0, 3.5]));
+    assert!(built.is_drivable([25.0, 6.0]) && built.is_drivable([25.0, 1.0]));
+    assert!(!built.is_drivable([25.0, 7.5]));
+}
