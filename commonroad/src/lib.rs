@@ -22,6 +22,7 @@ pub mod error;
 pub mod limits;
 pub mod model;
 mod read;
+mod read_lanelets;
 pub mod road;
 
 pub use error::{CommonRoadError, ErrorKind};

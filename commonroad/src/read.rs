@@ -10,8 +10,7 @@ use roxmltree::{Document, Node};
 use crate::error::{CommonRoadError, ErrorKind};
 use crate::limits::{MAX_FILE_BYTES, MAX_LANELETS, MAX_OBSTACLES, MAX_STATES_PER_OBSTACLE};
 use crate::model::{
-    Adjacent, DrivingDir, FormatVersion, Lanelet, Obstacle, PlanningProblem, Position, Scenario,
-    Shape, State, Value,
+    FormatVersion, Obstacle, PlanningProblem, Position, Scenario, Shape, State, Value,
 };
 
 /// Reads a CommonRoad XML file (format 2020a or 2018b).
@@ -59,29 +58,32 @@ pub fn read_str(path: &Path, text: &str) -> Result<Scenario, CommonRoadError> {
     .scenario()
 }
 
-struct Reader<'a, 'i> {
+pub(crate) struct Reader<'a, 'i> {
     path: PathBuf,
     doc: &'a Document<'i>,
 }
 
-type R<T> = Result<T, CommonRoadError>;
+pub(crate) type R<T> = Result<T, CommonRoadError>;
 
-fn children<'a, 'i>(node: Node<'a, 'i>, name: &'a str) -> impl Iterator<Item = Node<'a, 'i>> {
+pub(crate) fn children<'a, 'i>(
+    node: Node<'a, 'i>,
+    name: &'a str,
+) -> impl Iterator<Item = Node<'a, 'i>> {
     node.children()
         .filter(move |c| c.is_element() && c.tag_name().name() == name)
 }
 
-fn child<'a, 'i>(node: Node<'a, 'i>, name: &str) -> Option<Node<'a, 'i>> {
+pub(crate) fn child<'a, 'i>(node: Node<'a, 'i>, name: &str) -> Option<Node<'a, 'i>> {
     node.children()
         .find(|c| c.is_element() && c.tag_name().name() == name)
 }
 
 impl<'a, 'i> Reader<'a, 'i> {
-    fn line(&self, node: Node) -> u32 {
+    pub(crate) fn line(&self, node: Node) -> u32 {
         self.doc.text_pos_at(node.range().start).row
     }
 
-    fn err(&self, node: Node, owner: Option<&str>, kind: ErrorKind) -> CommonRoadError {
+    pub(crate) fn err(&self, node: Node, owner: Option<&str>, kind: ErrorKind) -> CommonRoadError {
         CommonRoadError {
             path: self.path.clone(),
             line: Some(self.line(node)),
@@ -90,7 +92,7 @@ impl<'a, 'i> Reader<'a, 'i> {
         }
     }
 
-    fn req<'n>(&self, node: Node<'n, 'i>, name: &str, owner: &str) -> R<Node<'n, 'i>> {
+    pub(crate) fn req<'n>(&self, node: Node<'n, 'i>, name: &str, owner: &str) -> R<Node<'n, 'i>> {
         child(node, name).ok_or_else(|| {
             self.err(
                 node,
@@ -102,7 +104,7 @@ impl<'a, 'i> Reader<'a, 'i> {
         })
     }
 
-    fn number(&self, node: Node, owner: &str) -> R<f64> {
+    pub(crate) fn number(&self, node: Node, owner: &str) -> R<f64> {
         let text = node.text().unwrap_or("").trim();
         match text.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
@@ -117,7 +119,7 @@ impl<'a, 'i> Reader<'a, 'i> {
         }
     }
 
-    fn id_attr(&self, node: Node, attr: &str, owner: Option<&str>) -> R<i64> {
+    pub(crate) fn id_attr(&self, node: Node, attr: &str, owner: Option<&str>) -> R<i64> {
         let text = node.attribute(attr).ok_or_else(|| {
             self.err(
                 node,
@@ -139,7 +141,7 @@ impl<'a, 'i> Reader<'a, 'i> {
         })
     }
 
-    fn point(&self, node: Node, owner: &str) -> R<[f64; 2]> {
+    pub(crate) fn point(&self, node: Node, owner: &str) -> R<[f64; 2]> {
         let x = self.number(self.req(node, "x", owner)?, owner)?;
         let y = self.number(self.req(node, "y", owner)?, owner)?;
         Ok([x, y])
@@ -168,7 +170,7 @@ impl<'a, 'i> Reader<'a, 'i> {
         child(node, name).map(|c| self.value(c, owner)).transpose()
     }
 
-    fn positive(&self, node: Node, owner: &str) -> R<f64> {
+    pub(crate) fn positive(&self, node: Node, owner: &str) -> R<f64> {
         let v = self.number(node, owner)?;
         if v > 0.0 {
             Ok(v)
@@ -417,135 +419,6 @@ impl<'a, 'i> Reader<'a, 'i> {
             dynamic_obstacles,
             static_obstacles,
             planning_problems,
-        })
-    }
-
-    /// 2020a traffic signs giving a maximum speed (German `274`, US `R2-1`): sign id → m/s.
-    fn speed_signs(&self, root: Node) -> R<HashMap<i64, f64>> {
-        let mut out = HashMap::new();
-        for sign in children(root, "trafficSign") {
-            let id = self.id_attr(sign, "id", Some("trafficSign"))?;
-            let owner = format!("trafficSign {id}");
-            for el in children(sign, "trafficSignElement") {
-                let code = child(el, "trafficSignID")
-                    .and_then(|c| c.text())
-                    .unwrap_or("")
-                    .trim();
-                if matches!(code, "274" | "R2-1")
-                    && let Some(v) = child(el, "additionalValue")
-                {
-                    out.insert(id, self.positive(v, &owner)?);
-                }
-            }
-        }
-        Ok(out)
-    }
-
-    fn reference(&self, node: Node, owner: &str, known: &HashMap<i64, u32>) -> R<i64> {
-        let id = self.id_attr(node, "ref", Some(owner))?;
-        if known.contains_key(&id) {
-            Ok(id)
-        } else {
-            Err(self.err(
-                node,
-                Some(owner),
-                ErrorKind::UnknownLanelet {
-                    field: node.tag_name().name().to_owned(),
-                    target: id,
-                },
-            ))
-        }
-    }
-
-    fn bound(&self, node: Node, owner: &str) -> R<Vec<[f64; 2]>> {
-        children(node, "point")
-            .map(|p| self.point(p, owner))
-            .collect()
-    }
-
-    fn adjacent(
-        &self,
-        node: Node,
-        name: &str,
-        owner: &str,
-        known: &HashMap<i64, u32>,
-    ) -> R<Option<Adjacent>> {
-        let Some(a) = child(node, name) else {
-            return Ok(None);
-        };
-        let id = self.reference(a, owner, known)?;
-        let driving_dir = match a.attribute("drivingDir").map(str::trim) {
-            Some("same") => DrivingDir::Same,
-            Some("opposite") => DrivingDir::Opposite,
-            other => {
-                return Err(self.err(
-                    a,
-                    Some(owner),
-                    ErrorKind::BadValue {
-                        field: format!("{name}.drivingDir"),
-                        reason: format!("{other:?} (expected \"same\" or \"opposite\")"),
-                    },
-                ));
-            }
-        };
-        Ok(Some(Adjacent { id, driving_dir }))
-    }
-
-    fn lanelet(
-        &self,
-        node: Node,
-        format: FormatVersion,
-        known: &HashMap<i64, u32>,
-        speed_signs: &HashMap<i64, f64>,
-    ) -> R<Lanelet> {
-        let id = self.id_attr(node, "id", Some("lanelet"))?;
-        let owner = format!("lanelet {id}");
-        let left_bound_m = self.bound(self.req(node, "leftBound", &owner)?, &owner)?;
-        let right_bound_m = self.bound(self.req(node, "rightBound", &owner)?, &owner)?;
-        if left_bound_m.len() != right_bound_m.len() || left_bound_m.len() < 2 {
-            let kind = if left_bound_m.len() == right_bound_m.len() {
-                ErrorKind::BadValue {
-                    field: "leftBound".into(),
-                    reason: format!("{} points (at least 2 needed)", left_bound_m.len()),
-                }
-            } else {
-                ErrorKind::BoundPointCounts {
-                    left: left_bound_m.len(),
-                    right: right_bound_m.len(),
-                }
-            };
-            return Err(self.err(node, Some(&owner), kind));
-        }
-        let refs = |name: &str| -> R<Vec<i64>> {
-            children(node, name)
-                .map(|c| self.reference(c, &owner, known))
-                .collect()
-        };
-        let mut speed_limit_mps = child(node, "speedLimit")
-            .map(|s| self.positive(s, &owner))
-            .transpose()?;
-        if format == FormatVersion::V2020a {
-            for r in children(node, "trafficSignRef") {
-                let sign = self.id_attr(r, "ref", Some(&owner))?;
-                if let Some(&v) = speed_signs.get(&sign) {
-                    speed_limit_mps = Some(speed_limit_mps.map_or(v, |s: f64| s.min(v)));
-                }
-            }
-        }
-        Ok(Lanelet {
-            id,
-            line: self.line(node),
-            left_bound_m,
-            right_bound_m,
-            predecessors: refs("predecessor")?,
-            successors: refs("successor")?,
-            adjacent_left: self.adjacent(node, "adjacentLeft", &owner, known)?,
-            adjacent_right: self.adjacent(node, "adjacentRight", &owner, known)?,
-            lanelet_types: children(node, "laneletType")
-                .filter_map(|t| t.text())
-                .map(|t| t.trim().to_owned())
-                .collect(),
-            speed_limit_mps,
         })
     }
 
