@@ -70,6 +70,16 @@ pub fn other_limits() -> Vec<(String, String)> {
                 .into(),
         ),
         (
+            "CommonRoad file (`merge_sim commonroad dump`)".into(),
+            format!(
+                "at most {} MiB, {} lanelets, {} obstacles, {} trajectory states per obstacle",
+                mergesim_commonroad::MAX_FILE_BYTES >> 20,
+                mergesim_commonroad::MAX_LANELETS,
+                mergesim_commonroad::MAX_OBSTACLES,
+                mergesim_commonroad::MAX_STATES_PER_OBSTACLE
+            ),
+        ),
+        (
             "`[sim.idm]` decelerations".into(),
             "`comfortable_decel_mps2` ≤ `max_decel_mps2`".into(),
         ),

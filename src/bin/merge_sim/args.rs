@@ -50,6 +50,23 @@ pub(crate) enum Command {
     /// Print the allowed range of every scenario value and the limits on runs, threads and
     /// work, as a Markdown table (the README's "Limits" section is this output).
     Limits,
+    /// Read CommonRoad XML scenarios (formats 2020a and 2018b).
+    #[command(subcommand)]
+    Commonroad(CommonroadCommand),
+}
+
+/// `merge_sim commonroad …`.
+#[derive(Subcommand, Debug, Clone)]
+pub(crate) enum CommonroadCommand {
+    /// Print what is read from a CommonRoad file as JSON on stdout: the lanelets, obstacles and
+    /// planning problems as in the file (`scenario`), each obstacle's states in replay form
+    /// (`replay`: interval midpoints, position rectangles' centres, time in s) and the road of
+    /// lanes built from the lanelet network (`lane_road`). Bad input: exit 2 naming the file,
+    /// the line and the element.
+    Dump {
+        /// The CommonRoad XML file.
+        file: std::path::PathBuf,
+    },
 }
 
 /// Which scenario, with which planner parameter set.

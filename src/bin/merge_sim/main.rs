@@ -11,6 +11,7 @@
 
 mod args;
 mod commands;
+mod commonroad_command;
 mod signals;
 mod study_command;
 mod sweep_commands;
@@ -65,6 +66,7 @@ fn main() -> ExitCode {
         Some(Command::Grid(args)) => commands::cmd_grid(&args, &interrupt),
         Some(Command::Study(args)) => study_command::cmd_study(&args, &interrupt),
         Some(Command::Limits) => commands::cmd_limits(),
+        Some(Command::Commonroad(cmd)) => commonroad_command::cmd_commonroad(&cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

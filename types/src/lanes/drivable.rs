@@ -48,6 +48,11 @@ fn true_intervals(samples: &[f64], pred: &dyn Fn(f64) -> bool) -> Vec<[f64; 2]> 
         let (mut lo, mut hi) = (a, b);
         while hi - lo > 1e-10 * (b - a).max(1e-9) {
             let m = 0.5 * (lo + hi);
+            // Samples a few ulps apart (bounds far along a long lane): stop when the
+            // midpoint can no longer split the interval, else the loop never ends.
+            if m <= lo || m >= hi {
+                break;
+            }
             if pred(m) == va {
                 lo = m;
             } else {
@@ -253,6 +258,21 @@ impl LaneRoad {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn intervals_end_for_samples_a_few_ulps_apart() {
+        // Two samples 2 ulps apart far along a lane (as the A9 CommonRoad map gives): the
+        // bisection used to loop for ever once the midpoint equalled an end.
+        let a = 700.0_f64;
+        let b = f64::from_bits(a.to_bits() + 2);
+        let mid = f64::from_bits(a.to_bits() + 1);
+        let out = true_intervals(&[0.0, a, b, 800.0], &|s| s >= mid);
+        assert_eq!(out.len(), 1);
+        assert!(
+            out[0][0] >= a && out[0][0] <= b && out[0][1] == 800.0,
+            "{out:?}"
+        );
+    }
 
     #[test]
     fn intervals_find_and_snap_transitions() {
