@@ -89,7 +89,7 @@ pub enum RoadSide {
     Right,
 }
 
-/// The side of segment `a → b` the drivable area lies on: probed [`SIDE_PROBE_M`] to the left
+/// The side of segment `a → b` the drivable area lies on: probed `SIDE_PROBE_M` to the left
 /// and to the right of the segment's midpoint. `None` for a degenerate segment or when the
 /// probe cannot tell (both sides drivable or neither).
 pub fn road_side_of(lanes: &LaneRoad, a: [f64; 2], b: [f64; 2]) -> Option<RoadSide> {
