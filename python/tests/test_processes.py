@@ -46,6 +46,9 @@ def test_async_vector_env_after_the_parent_simulated() -> None:
 
 
 def _interrupt_after(seconds: float) -> threading.Timer:
+    # Python's own Ctrl-C handler, whatever this process inherited: a shell without job control
+    # starts background commands with SIGINT ignored, and Python then installs no handler.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
     timer.start()
     return timer
