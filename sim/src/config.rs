@@ -8,6 +8,7 @@ use mergesim_types::{Bound, bounds};
 
 use crate::error::SimError;
 use crate::idm::IdmParams;
+use crate::recorded_traffic::RecordedTraffic;
 use crate::road_config::{LaneRoadConfig, StartLane, build_lane_road};
 use crate::safety::SafetyParams;
 use crate::v2v::V2vParams;
@@ -49,6 +50,10 @@ pub struct SimConfig {
     pub safety: SafetyParams,
     /// Intelligent Driver Model of the human-driven (`driver = "idm"`) vehicles.
     pub idm: IdmParams,
+    /// Recorded vehicles replayed beside the simulated ones (`crate::recorded_traffic`): filled
+    /// by the scenario loader from the road's source file, never written in a scenario.
+    #[serde(skip)]
+    pub recorded_traffic: RecordedTraffic,
 }
 
 impl Default for SimConfig {
@@ -69,6 +74,7 @@ impl Default for SimConfig {
             tracker: TrackerParams::default(),
             safety: SafetyParams::default(),
             idm: IdmParams::default(),
+            recorded_traffic: RecordedTraffic::default(),
         }
     }
 }
