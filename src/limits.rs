@@ -80,6 +80,15 @@ pub fn other_limits() -> Vec<(String, String)> {
             ),
         ),
         (
+            "OpenDRIVE file (`merge_sim opendrive dump`)".into(),
+            format!(
+                "at most {} MiB, {} drivable lanes, every lane within {} km of the origin",
+                mergesim_opendrive::MAX_FILE_BYTES >> 20,
+                mergesim_opendrive::MAX_LANES,
+                mergesim_opendrive::MAX_COORDINATE_M / 1000.0
+            ),
+        ),
+        (
             "`[sim.idm]` decelerations".into(),
             "`comfortable_decel_mps2` ≤ `max_decel_mps2`".into(),
         ),

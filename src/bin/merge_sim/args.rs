@@ -53,6 +53,22 @@ pub(crate) enum Command {
     /// Read CommonRoad XML scenarios (formats 2020a and 2018b).
     #[command(subcommand)]
     Commonroad(CommonroadCommand),
+    /// Read a road's geometry from an OpenDRIVE (.xodr) file.
+    #[command(subcommand)]
+    Opendrive(OpendriveCommand),
+}
+
+/// `merge_sim opendrive …`.
+#[derive(Subcommand, Debug, Clone)]
+pub(crate) enum OpendriveCommand {
+    /// Print the road of lanes taken from an OpenDRIVE file as JSON on stdout: each mergesim
+    /// lane's OpenDRIVE origin (`lanes`: id, road id, lane section, `<lane id>`, lane type) and
+    /// the lanes themselves (`lane_road`: centrelines in travel direction, widths, links). Only
+    /// drivable lanes are taken; elevation is dropped. Bad input: exit 2 naming the file.
+    Dump {
+        /// The OpenDRIVE file.
+        file: std::path::PathBuf,
+    },
 }
 
 /// `merge_sim commonroad …`.

@@ -12,6 +12,7 @@
 mod args;
 mod commands;
 mod commonroad_command;
+mod opendrive_command;
 mod signals;
 mod study_command;
 mod sweep_commands;
@@ -67,6 +68,7 @@ fn main() -> ExitCode {
         Some(Command::Study(args)) => study_command::cmd_study(&args, &interrupt),
         Some(Command::Limits) => commands::cmd_limits(),
         Some(Command::Commonroad(cmd)) => commonroad_command::cmd_commonroad(&cmd),
+        Some(Command::Opendrive(cmd)) => opendrive_command::cmd_opendrive(&cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
