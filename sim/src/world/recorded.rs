@@ -96,7 +96,7 @@ impl Handover {
     pub fn describe(&self) -> String {
         format!(
             "t = {:.3} s: recorded vehicle {} hands over to IDM behind {}: its recording would \
-             leave a gap of {:.2} m < s* = {:.2} m (v = {:.2} m/s, Δv = {:.2} m/s)",
+             leave a gap of {:.3} m < s* = {:.3} m (v = {:.2} m/s, Δv = {:.2} m/s)",
             self.t_s,
             self.name,
             self.leader,
