@@ -2,8 +2,9 @@
 //! the V2V bus and the safety monitor, and advances them in a fixed order every physics step:
 //!
 //! 1. V2V delivery → 2. planning (each vehicle at its own period, visited by id) and broadcast →
-//! 3. tracking → 4. tire and suspension forces, rapier step → 5. parry safety checks →
-//! 6. the observers: metrics, time series and recording (on their own clock; `crate::observer`).
+//! 3. tracking → 4. tire and suspension forces, recorded traffic's kinematic targets
+//! (`recorded`), rapier step → 5. parry safety checks → 6. the observers: metrics, time series
+//! and recording (on their own clock; `crate::observer`).
 //!
 //! Same configuration + same seed ⇒ bitwise identical results: vehicles are visited by index,
 //! every map is ordered, and the only randomness (V2V drops) comes from a seeded stream.
@@ -529,6 +530,16 @@ impl World {
         self.profiler.stop(Phase::Metrics, started);
         let started = self.profiler.start();
         self.recording.on_log(t_s, &views)?;
+        if !self.recorded.is_empty() {
+            // Recorded traffic: drawn, not in the time series (`recorded` module doc).
+            let names = self.names();
+            let recorded = &bodies[self.agents.len()..];
+            let labels: Vec<String> = recorded
+                .iter()
+                .map(|b| names.get(b.id as usize).cloned().unwrap_or_default())
+                .collect();
+            self.recording.log_recorded(recorded, &labels)?;
+        }
         self.profiler.stop(Phase::Recording, started);
         Ok(())
     }

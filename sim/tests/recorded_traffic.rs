@@ -443,3 +443,42 @@ fn recorded_traffic_runs_are_bitwise_identical_on_1_and_4_threads() {
     assert!(one.safety.min_gap_to_recorded_m.is_some());
     assert_eq!(bits(&one), bits(&four));
 }
+
+#[test]
+fn the_recording_draws_recorded_vehicles_with_their_names() {
+    use re_log_encoding::DecoderApp;
+    use rerun::log::{Chunk, LogMsg};
+    let dir = std::env::temp_dir().join(format!("mergesim_recorded_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{e}"));
+    let path = dir.join("run.rrd");
+    let parked = recorded("cr-parked", vec![state(0.0, 150.0, 0.0)]);
+    let recorder = Recorder::new_file(&path, "mergesim_test").unwrap_or_else(|e| panic!("{e}"));
+    World::new(
+        config(0.5, TrafficMode::Replay, vec![parked]),
+        &[spec("ego", 100.0, 10.0, Driver::LaneKeeping)],
+        &RunOptions::default(),
+        recorder,
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+    .run(|_| {})
+    .unwrap_or_else(|e| panic!("{e}"));
+    let file = std::fs::File::open(&path).unwrap_or_else(|e| panic!("{e}"));
+    let mut labels = Vec::new();
+    let component = rerun::Boxes2D::descriptor_labels().component;
+    for msg in DecoderApp::decode_lazy(std::io::BufReader::new(file)) {
+        let msg = msg.unwrap_or_else(|e| panic!("{e}"));
+        if let LogMsg::ArrowMsg(_, arrow_msg) = &msg {
+            let chunk = Chunk::from_arrow_msg(arrow_msg).unwrap_or_else(|e| panic!("{e}"));
+            if chunk.entity_path().to_string() == "/world/recorded_vehicles" {
+                for row in chunk.iter_component::<rerun::components::Text>(component) {
+                    labels.extend(row.iter().map(|t| t.to_string()));
+                }
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    // One label per logged instant (20 Hz over 0.5 s, the first instant after the first log
+    // period).
+    assert!(labels.len() >= 10, "{labels:?}");
+    assert!(labels.iter().all(|l| l == "cr-parked"), "{labels:?}");
+}

@@ -149,6 +149,15 @@ pub struct SafetySummary {
     pub ttc_not_converged: u64,
 }
 
+impl SafetySummary {
+    /// The collision episodes that are not caused by the replay of recorded traffic: the
+    /// simulated vehicles' own (vehicle–vehicle only; road-edge contacts are apart).
+    pub fn own_collisions(&self) -> usize {
+        self.collisions.len()
+            - (self.collisions_caused_by_replay as usize).min(self.collisions.len())
+    }
+}
+
 /// What one pair looked like at the last checked instant.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PairInstant {

@@ -37,6 +37,13 @@
 //! length and width, the default preset's wheelbase and the default braking capability
 //! (`VehicleShape::default().max_brake_decel_mps2`, 7 m/s²), within `perception_range_m`;
 //! never a shared path.
+//!
+//! # Outputs
+//! The safety monitor checks simulated–recorded pairs, not recorded–recorded ones
+//! (`crate::safety`'s `recorded_pairs`). The recording draws recorded vehicles as grey boxes
+//! with their names (`world/recorded_vehicles`). They have no rows in the time series (`--csv`)
+//! and no entry in `RunOutcome::vehicles`: those stay the simulated vehicles' (a recording's
+//! own trajectory is in its source file).
 
 use mergesim_types::lanes::{LaneId, LaneRoad};
 use mergesim_types::{Neighbour, VehicleId, VehicleShape, VehicleState};
@@ -421,12 +428,5 @@ impl RecordedFleet {
                 })
             })
             .collect()
-    }
-
-    /// The present recorded vehicles' names and states, in id order (for the recording).
-    pub(crate) fn present(&self) -> impl Iterator<Item = (&str, &RecordedVehicle, RecordedState)> {
-        self.members
-            .iter()
-            .filter_map(|m| m.current.map(|s| (m.vehicle.name.as_str(), &m.vehicle, s)))
     }
 }
