@@ -453,17 +453,18 @@ impl World {
         } else {
             Vec::new()
         };
-        let names = self.names();
         let handovers = self.recorded.advance(
             t_s,
             self.config.dt_s,
             &self.lanes,
             &simulated,
-            &names,
             &mut self.physics,
         )?;
-        for handover in handovers {
-            self.event(handover.describe(), EventLevel::Info)?;
+        if !handovers.is_empty() {
+            let names = self.names();
+            for handover in handovers {
+                self.event(handover.describe(&names), EventLevel::Info)?;
+            }
         }
         Ok(())
     }

@@ -87,7 +87,7 @@ pub struct Handover {
     /// The recorded vehicle.
     pub name: String,
     /// The simulated vehicle ahead.
-    pub leader: String,
+    pub leader: VehicleId,
     /// The bumper gap the recording would have left at the next step (m).
     pub gap_m: f64,
     /// IDM's safe gap s* there (m).
@@ -99,14 +99,18 @@ pub struct Handover {
 }
 
 impl Handover {
-    /// The event line.
-    pub fn describe(&self) -> String {
+    /// The event line; `names[id]` names vehicle `id`.
+    pub fn describe(&self, names: &[String]) -> String {
+        let leader = names
+            .get(self.leader as usize)
+            .cloned()
+            .unwrap_or_else(|| format!("vehicle {}", self.leader));
         format!(
             "t = {:.3} s: recorded vehicle {} hands over to IDM behind {}: its recording would \
              leave a gap of {:.3} m < s* = {:.3} m (v = {:.2} m/s, Δv = {:.2} m/s)",
             self.t_s,
             self.name,
-            self.leader,
+            leader,
             self.gap_m,
             self.safe_gap_m,
             self.speed_mps,
@@ -225,15 +229,13 @@ impl RecordedFleet {
 
     /// Moves every recorded vehicle from the world's time `t_s` to `t_s + dt_s` (module doc):
     /// sets the kinematic targets of the coming physics step. `simulated` are the simulated
-    /// bodies at `t_s` (used in reactive mode only), `names` every vehicle's name by id.
-    /// Returns the handovers of this step.
+    /// bodies at `t_s` (used in reactive mode only). Returns the handovers of this step.
     pub(crate) fn advance(
         &mut self,
         t_s: f64,
         dt_s: f64,
         lanes: &LaneRoad,
         simulated: &[BodyState],
-        names: &[String],
         physics: &mut PhysicsWorld,
     ) -> Result<Vec<Handover>, SimError> {
         let next_t_s = t_s + dt_s;
@@ -250,7 +252,7 @@ impl RecordedFleet {
             let next = match (recorded_next, member.current) {
                 (Some(next), Some(now)) if self.mode == TrafficMode::Reactive => {
                     if member.idm.is_none()
-                        && let Some(h) = self.handover(member, &next, lanes, simulated, names, t_s)
+                        && let Some(h) = self.handover(member, &next, lanes, simulated, t_s)
                     {
                         let hit = lane_of(lanes, member.lane, now.position_m);
                         member.idm = Some(IdmMotion {
@@ -284,7 +286,6 @@ impl RecordedFleet {
         next: &RecordedState,
         lanes: &LaneRoad,
         simulated: &[BodyState],
-        names: &[String],
         t_s: f64,
     ) -> Option<Handover> {
         let hit = lane_of(lanes, member.lane, next.position_m);
@@ -312,10 +313,8 @@ impl RecordedFleet {
         (leader.gap_m < safe_gap_m).then(|| Handover {
             t_s,
             name: member.vehicle.name.clone(),
-            leader: simulated
-                .get(leader.index - 1)
-                .and_then(|b| names.get(b.id as usize).cloned())
-                .unwrap_or_default(),
+            // `users` is the member, then `simulated` in order.
+            leader: simulated.get(leader.index - 1).map_or(0, |b| b.id),
             gap_m: leader.gap_m,
             safe_gap_m,
             speed_mps: v,
