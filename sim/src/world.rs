@@ -3,8 +3,8 @@
 //!
 //! 1. V2V delivery → 2. planning (each vehicle at its own period, visited by id) and broadcast →
 //! 3. tracking → 4. tire and suspension forces, recorded traffic's kinematic targets
-//! (`recorded`), rapier step → 5. parry safety checks → 6. the observers: metrics, time series
-//! and recording (on their own clock; `crate::observer`).
+//!    (`recorded`), rapier step → 5. parry safety checks → 6. the observers: metrics, time
+//!    series and recording (on their own clock; `crate::observer`).
 //!
 //! Same configuration + same seed ⇒ bitwise identical results: vehicles are visited by index,
 //! every map is ordered, and the only randomness (V2V drops) comes from a seeded stream.
