@@ -171,3 +171,78 @@ impl RunSummary {
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sim::recorded_traffic::{RecordedState, RecordedTraffic, RecordedVehicle, TrafficMode};
+    use sim::recording::Recorder;
+    use sim::{Driver, Lane, RunOptions, SimConfig, VehicleSpec, World};
+
+    /// A recorded car running into a lane-keeping car from behind (as in
+    /// `sim/tests/recorded_traffic.rs`): the summary counts it apart.
+    #[test]
+    fn collisions_caused_by_recorded_traffic_are_counted_apart_in_the_summary() {
+        let state = |time_s: f64, x_m: f64| RecordedState {
+            time_s,
+            position_m: [x_m, 5.25],
+            heading_rad: 0.0,
+            speed_mps: 15.0,
+        };
+        let config = SimConfig {
+            duration_s: 20.0,
+            recorded_traffic: RecordedTraffic {
+                mode: TrafficMode::Replay,
+                vehicles: vec![RecordedVehicle {
+                    name: "cr-follower".into(),
+                    length_m: 4.5,
+                    width_m: 1.8,
+                    states: vec![state(0.0, 0.0), state(19.6, 294.0)],
+                }],
+            },
+            ..SimConfig::default()
+        };
+        let ego = VehicleSpec {
+            name: "ego".into(),
+            preset: "bmw_320i".into(),
+            lane: Lane::Upper.into(),
+            x_m: 100.0,
+            y_offset_m: 0.0,
+            speed_mps: 10.0,
+            target_speed_mps: 10.0,
+            driver: Driver::LaneKeeping,
+            connected: false,
+        };
+        let outcome = World::new(config, &[ego], &RunOptions::default(), Recorder::disabled())
+            .and_then(|w| w.run(|_| {}))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let summary = RunSummary::new(
+            "rear_end",
+            planner::ParameterSet::default(),
+            "lane-keeping",
+            None,
+            0.0,
+            &outcome,
+        );
+        assert!(!outcome.safety.collisions.is_empty());
+        assert_eq!(summary.collisions, outcome.safety.edge_contacts.len());
+        assert_eq!(
+            summary.collisions_caused_by_replay,
+            outcome.safety.collisions.len()
+        );
+        assert!(summary.min_gap_to_recorded_m.is_some_and(|g| g < 0.01));
+        assert_eq!(summary.min_ttc_to_recorded_s, Some(0.0));
+        let json = serde_json::to_value(&summary).unwrap_or_default();
+        assert_eq!(
+            json["collisions_caused_by_replay"],
+            serde_json::json!(summary.collisions_caused_by_replay)
+        );
+        assert!(
+            summary
+                .table()
+                .contains("recorded traffic: collisions caused by replay"),
+            "{}",
+            summary.table()
+        );
+    }
+}
