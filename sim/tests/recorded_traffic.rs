@@ -254,7 +254,29 @@ fn rear_end(mode: TrafficMode) -> (SimConfig, Vec<VehicleSpec>) {
 #[test]
 fn replay_running_into_a_simulated_car_from_behind_is_counted_apart() {
     let (config, specs) = rear_end(TrafficMode::Replay);
-    let outcome = run(config, &specs);
+    let outcome = World::new(
+        config,
+        &specs,
+        &RunOptions {
+            keep_time_series: true,
+            ..RunOptions::default()
+        },
+        Recorder::disabled(),
+    )
+    .and_then(|w| w.run(|_| {}))
+    .unwrap_or_else(|e| panic!("{e}"));
+    // The recorded box is in the physics scene: it shoves the ego forward (the ego holds
+    // 10 m/s until then).
+    let speed_at = |lo: f64, hi: f64| {
+        outcome
+            .time_series
+            .iter()
+            .filter(|r| r.t_s >= lo && r.t_s <= hi)
+            .map(|r| r.speed_mps)
+            .fold(0.0, f64::max)
+    };
+    assert!(speed_at(10.0, 18.9) < 10.5, "{}", speed_at(10.0, 18.9));
+    assert!(speed_at(19.1, 20.0) > 12.0, "{}", speed_at(19.1, 20.0));
     let safety = &outcome.safety;
     // The first contact, then the recorded car (kinematic: it never yields) keeps pushing:
     // more contact episodes, all the replay's.
