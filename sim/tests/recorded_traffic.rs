@@ -504,3 +504,75 @@ fn the_recording_draws_recorded_vehicles_with_their_names() {
     assert!(labels.len() >= 10, "{labels:?}");
     assert!(labels.iter().all(|l| l == "cr-parked"), "{labels:?}");
 }
+
+#[test]
+fn recorded_traffic_works_on_a_turned_lane_road_far_from_the_origin() {
+    use mergesim_types::lanes::{LaneId, LaneSpec};
+    // One lane 5.9 km from the origin (Rapier works around a local origin near the road),
+    // heading 0.5 rad.
+    let heading_rad: f64 = 0.5;
+    let (s, c) = heading_rad.sin_cos();
+    let origin = [5900.0, 3000.0];
+    let at = |s_m: f64| [origin[0] + s_m * c, origin[1] + s_m * s];
+    let lane = LaneSpec::new(
+        LaneId(1),
+        (0..=8).map(|k| at(50.0 * k as f64)).collect(),
+        3.5,
+    );
+    let ego = VehicleSpec {
+        lane: LaneId(1).into(),
+        x_m: 50.0,
+        ..spec("ego", 0.0, 10.0, Driver::LaneKeeping)
+    };
+    // Parked 50 m ahead along the lane: the ego hits it (its own collision) after about
+    // (50 − 4.5) / 10 ≈ 4.55 s, as on the straight road at the origin.
+    let parked = RecordedVehicle {
+        states: vec![RecordedState {
+            time_s: 0.0,
+            position_m: at(100.0),
+            heading_rad,
+            speed_mps: 0.0,
+        }],
+        ..recorded("cr-parked", Vec::new())
+    };
+    let config = SimConfig {
+        duration_s: 5.0,
+        lane_road: Some(sim::LaneRoadConfig {
+            lanes: vec![lane],
+            ..sim::LaneRoadConfig::default()
+        }),
+        recorded_traffic: RecordedTraffic {
+            mode: TrafficMode::Replay,
+            vehicles: vec![parked],
+        },
+        ..SimConfig::default()
+    };
+    let outcome = World::new(
+        config,
+        &[ego],
+        &RunOptions {
+            keep_time_series: true,
+            ..RunOptions::default()
+        },
+        Recorder::disabled(),
+    )
+    .and_then(|w| w.run(|_| {}))
+    .unwrap_or_else(|e| panic!("{e}"));
+    // Rapier stops the ego at the box (at the right place, despite the local origin): its
+    // centre never gets within half of both lengths (4.5 m) of the parked car's.
+    let furthest_m = outcome
+        .time_series
+        .iter()
+        .map(|r| (r.x_m - origin[0]) * c + (r.y_m - origin[1]) * s)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!((94.0..96.0).contains(&furthest_m), "{furthest_m}");
+    let safety = &outcome.safety;
+    assert!(!safety.collisions.is_empty(), "{:?}", outcome.events);
+    assert!(safety.collisions.iter().all(|c| !c.caused_by_replay));
+    assert!(
+        (4.3..4.8).contains(&safety.collisions[0].t_s),
+        "{:?}",
+        safety.collisions
+    );
+    assert!(outcome.vehicles[0].collided);
+}
