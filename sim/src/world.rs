@@ -455,7 +455,8 @@ impl World {
         };
         let handovers = self.recorded.advance(
             t_s,
-            self.config.dt_s,
+            // The world's clock after the step (`Self::time_s`), not t + dt rounded apart.
+            (self.step_index + 1) as f64 * self.config.dt_s,
             &self.lanes,
             &simulated,
             &mut self.physics,

@@ -227,18 +227,18 @@ impl RecordedFleet {
         self.members.iter().map(|m| m.vehicle.name.as_str())
     }
 
-    /// Moves every recorded vehicle from the world's time `t_s` to `t_s + dt_s` (module doc):
+    /// Moves every recorded vehicle from the world's time `t_s` to `next_t_s` (module doc):
     /// sets the kinematic targets of the coming physics step. `simulated` are the simulated
     /// bodies at `t_s` (used in reactive mode only). Returns the handovers of this step.
     pub(crate) fn advance(
         &mut self,
         t_s: f64,
-        dt_s: f64,
+        next_t_s: f64,
         lanes: &LaneRoad,
         simulated: &[BodyState],
         physics: &mut PhysicsWorld,
     ) -> Result<Vec<Handover>, SimError> {
-        let next_t_s = t_s + dt_s;
+        let dt_s = next_t_s - t_s;
         let mut handovers = Vec::new();
         // Everyone's state now, for the IDM leaders (sequential, id order: deterministic).
         let others: Vec<(VehicleId, RecordedState, f64)> = self
