@@ -82,7 +82,8 @@ impl RecordedTraffic {
     /// state, finite values, a speed ≥ 0 and strictly increasing times. The error names the
     /// field as `recorded_traffic.vehicles[NAME].…`.
     pub fn validate(&self, other_names: &[String]) -> Result<(), SimError> {
-        let mut names: Vec<&str> = other_names.iter().map(String::as_str).collect();
+        let mut names: std::collections::BTreeSet<&str> =
+            other_names.iter().map(String::as_str).collect();
         for (index, v) in self.vehicles.iter().enumerate() {
             let label = if v.name.is_empty() {
                 format!("#{index}")
@@ -96,13 +97,12 @@ impl RecordedTraffic {
             if v.name.is_empty() {
                 return Err(bad("name", "must not be empty".into()));
             }
-            if names.contains(&v.name.as_str()) {
+            if !names.insert(v.name.as_str()) {
                 return Err(bad(
                     "name",
                     format!("{} is used by another vehicle", v.name),
                 ));
             }
-            names.push(&v.name);
             for (field, value) in [("length_m", v.length_m), ("width_m", v.width_m)] {
                 if !(value.is_finite() && value > 0.0 && value <= 100.0) {
                     return Err(bad(field, format!("{value} must lie in (0, 100] m")));
