@@ -256,7 +256,7 @@ fn run_job(
     let result = run_quietly(&cell_scenario, &options).map(|finished| finished.outcome);
     let (collisions, error, vehicles) = match result {
         Ok(outcome) => (
-            Some((outcome.safety.collisions.len() + outcome.safety.edge_contacts.len()) as u64),
+            Some((outcome.safety.own_collisions() + outcome.safety.edge_contacts.len()) as u64),
             None,
             figures(&outcome),
         ),

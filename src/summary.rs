@@ -25,8 +25,21 @@ pub struct RunSummary {
     pub duration_s: f64,
     /// Wall-clock time of the simulation (s); the only field that differs between reruns.
     pub wall_time_s: f64,
-    /// Number of collision events (vehicle–vehicle and vehicle–road edge).
+    /// Number of collision events (vehicle–vehicle and vehicle–road edge) of the simulated
+    /// vehicles, without those caused by the replay of recorded traffic.
     pub collisions: usize,
+    /// Collisions in which a recorded vehicle ran into a simulated one from behind (counted
+    /// apart from `collisions`); 0 without recorded traffic.
+    #[serde(default)]
+    pub collisions_caused_by_replay: usize,
+    /// Exact minimum distance between a simulated and a recorded vehicle's boxes (m); null
+    /// without recorded traffic within `pair_range_m`.
+    #[serde(default)]
+    pub min_gap_to_recorded_m: Option<f64>,
+    /// Minimum time to collision between a simulated and a recorded vehicle (s); null if no
+    /// such pair was ever closing within the horizon.
+    #[serde(default)]
+    pub min_ttc_to_recorded_s: Option<f64>,
     /// Exact minimum distance between any two vehicle boxes (m); null with a single vehicle
     /// or when no two ever came within `[sim.safety] pair_range_m` (250 m).
     pub min_gap_m: Option<f64>,
@@ -65,7 +78,10 @@ impl RunSummary {
             drawn: None,
             duration_s: outcome.duration_s,
             wall_time_s,
-            collisions: outcome.safety.collisions.len() + outcome.safety.edge_contacts.len(),
+            collisions: outcome.safety.own_collisions() + outcome.safety.edge_contacts.len(),
+            collisions_caused_by_replay: outcome.safety.collisions_caused_by_replay as usize,
+            min_gap_to_recorded_m: outcome.safety.min_gap_to_recorded_m,
+            min_ttc_to_recorded_s: outcome.safety.min_ttc_to_recorded_s,
             min_gap_m: outcome.safety.min_gap_m,
             min_ttc_s: outcome.safety.min_ttc_s,
             near_miss: outcome.safety.near_miss,
@@ -107,6 +123,18 @@ impl RunSummary {
             if self.near_miss { "yes" } else { "no" },
             self.tet_s
         ));
+        if self.collisions_caused_by_replay > 0 || self.min_gap_to_recorded_m.is_some() {
+            out.push_str(&format!(
+                "recorded traffic: collisions caused by replay {}  min gap {}  min TTC {}\n",
+                self.collisions_caused_by_replay,
+                self.min_gap_to_recorded_m
+                    .map(|g| format!("{g:.2} m"))
+                    .unwrap_or_else(|| "-".into()),
+                self.min_ttc_to_recorded_s
+                    .map(|t| format!("{t:.2} s"))
+                    .unwrap_or_else(|| "never closing".into()),
+            ));
+        }
         out.push_str(&format!(
             "planner cycles {}  fallbacks {}  p50 {:.0} µs  p99 {:.0} µs\n\n",
             self.planner_stats.plans,
@@ -141,5 +169,80 @@ impl RunSummary {
             ));
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sim::recorded_traffic::{RecordedState, RecordedTraffic, RecordedVehicle, TrafficMode};
+    use sim::recording::Recorder;
+    use sim::{Driver, Lane, RunOptions, SimConfig, VehicleSpec, World};
+
+    /// A recorded car running into a lane-keeping car from behind (as in
+    /// `sim/tests/recorded_traffic.rs`): the summary counts it apart.
+    #[test]
+    fn collisions_caused_by_recorded_traffic_are_counted_apart_in_the_summary() {
+        let state = |time_s: f64, x_m: f64| RecordedState {
+            time_s,
+            position_m: [x_m, 5.25],
+            heading_rad: 0.0,
+            speed_mps: 15.0,
+        };
+        let config = SimConfig {
+            duration_s: 20.0,
+            recorded_traffic: RecordedTraffic {
+                mode: TrafficMode::Replay,
+                vehicles: vec![RecordedVehicle {
+                    name: "cr-follower".into(),
+                    length_m: 4.5,
+                    width_m: 1.8,
+                    states: vec![state(0.0, 0.0), state(19.6, 294.0)],
+                }],
+            },
+            ..SimConfig::default()
+        };
+        let ego = VehicleSpec {
+            name: "ego".into(),
+            preset: "bmw_320i".into(),
+            lane: Lane::Upper.into(),
+            x_m: 100.0,
+            y_offset_m: 0.0,
+            speed_mps: 10.0,
+            target_speed_mps: 10.0,
+            driver: Driver::LaneKeeping,
+            connected: false,
+        };
+        let outcome = World::new(config, &[ego], &RunOptions::default(), Recorder::disabled())
+            .and_then(|w| w.run(|_| {}))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let summary = RunSummary::new(
+            "rear_end",
+            planner::ParameterSet::default(),
+            "lane-keeping",
+            None,
+            0.0,
+            &outcome,
+        );
+        assert!(!outcome.safety.collisions.is_empty());
+        assert_eq!(summary.collisions, outcome.safety.edge_contacts.len());
+        assert_eq!(
+            summary.collisions_caused_by_replay,
+            outcome.safety.collisions.len()
+        );
+        assert!(summary.min_gap_to_recorded_m.is_some_and(|g| g < 0.01));
+        assert_eq!(summary.min_ttc_to_recorded_s, Some(0.0));
+        let json = serde_json::to_value(&summary).unwrap_or_default();
+        assert_eq!(
+            json["collisions_caused_by_replay"],
+            serde_json::json!(summary.collisions_caused_by_replay)
+        );
+        assert!(
+            summary
+                .table()
+                .contains("recorded traffic: collisions caused by replay"),
+            "{}",
+            summary.table()
+        );
     }
 }

@@ -15,6 +15,7 @@ pub mod observer;
 pub mod outcome;
 pub mod paper_metrics;
 pub mod profile;
+pub mod recorded_motion;
 pub mod recorded_traffic;
 pub mod recording;
 pub mod recording_observer;

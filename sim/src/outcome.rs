@@ -105,7 +105,8 @@ pub struct RunOutcome {
     pub duration_s: f64,
     /// Exact safety results.
     pub safety: SafetySummary,
-    /// Per-vehicle metrics, in vehicle order.
+    /// Per-vehicle metrics of the simulated vehicles, in vehicle order (recorded traffic has
+    /// none, nor time-series rows).
     pub vehicles: Vec<VehicleMetricsSummary>,
     /// Planner counters.
     pub planner_stats: PlannerStats,

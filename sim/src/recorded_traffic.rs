@@ -55,7 +55,8 @@ pub struct RecordedVehicle {
     /// Its rectangle's width (m).
     pub width_m: f64,
     /// Its states, at strictly increasing times; at least one. It exists from the first
-    /// state's time to the last's.
+    /// state's time to the last's, interpolated between them (`crate::recorded_motion`); with a
+    /// single state it exists for the whole run and stands still there.
     pub states: Vec<RecordedState>,
 }
 

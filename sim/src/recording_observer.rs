@@ -80,6 +80,15 @@ impl RecordingObserver {
     fn enabled(&mut self) -> Option<&mut Recorder> {
         self.recorder.as_mut().filter(|r| r.is_enabled())
     }
+
+    /// Draws the recorded vehicles present at `t_s` (after [`TickObserver::on_log`] of the same
+    /// instant, which sets the time): `names[i]` labels `bodies[i]`.
+    pub fn log_recorded(&mut self, bodies: &[BodyState], names: &[String]) -> Result<(), SimError> {
+        let Some(recorder) = self.enabled() else {
+            return Ok(());
+        };
+        recorder.log_recorded_vehicles(bodies, names).map_err(rec)
+    }
 }
 
 impl TickObserver for RecordingObserver {

@@ -2,8 +2,9 @@
 //! the V2V bus and the safety monitor, and advances them in a fixed order every physics step:
 //!
 //! 1. V2V delivery → 2. planning (each vehicle at its own period, visited by id) and broadcast →
-//! 3. tracking → 4. tire and suspension forces, rapier step → 5. parry safety checks →
-//! 6. the observers: metrics, time series and recording (on their own clock; `crate::observer`).
+//! 3. tracking → 4. tire and suspension forces, recorded traffic's kinematic targets
+//!    (`recorded`), rapier step → 5. parry safety checks → 6. the observers: metrics, time
+//!    series and recording (on their own clock; `crate::observer`).
 //!
 //! Same configuration + same seed ⇒ bitwise identical results: vehicles are visited by index,
 //! every map is ordered, and the only randomness (V2V drops) comes from a seeded stream.
@@ -30,6 +31,9 @@ use crate::v2v::V2vBus;
 
 mod lanes;
 mod planning;
+mod recorded;
+
+pub use recorded::Handover;
 
 /// Options of one run that are not part of the scenario.
 #[derive(Clone, Debug, Default)]
@@ -52,6 +56,8 @@ pub struct World {
     lanes: std::sync::Arc<mergesim_types::lanes::LaneRoad>,
     physics: PhysicsWorld,
     agents: Vec<Agent>,
+    /// The recorded traffic (`recorded`), ids after the agents'.
+    recorded: recorded::RecordedFleet,
     bus: V2vBus,
     safety: SafetyMonitor,
     run_log: RunLog,
@@ -123,11 +129,21 @@ impl World {
                 options.planner_override.as_deref(),
             )?);
         }
+        let simulated_names: Vec<String> = specs.iter().map(|s| s.name.clone()).collect();
+        let recorded = recorded::RecordedFleet::new(
+            &config.recorded_traffic,
+            &simulated_names,
+            &config.idm,
+            &mut physics,
+        )?;
         let bus = V2vBus::new(
             config.v2v.clone(),
             crate::rng::SplitMix64::derive(options.seed, 1),
         )?;
-        let safety = SafetyMonitor::new(config.safety.clone(), lanes.clone())?;
+        let mut safety = SafetyMonitor::new(config.safety.clone(), lanes.clone())?;
+        if !recorded.is_empty() {
+            safety.set_recorded_from(agents.len() as VehicleId);
+        }
         let metrics = agents
             .iter()
             .map(|a| {
@@ -145,6 +161,7 @@ impl World {
             lanes,
             physics,
             agents,
+            recorded,
             bus,
             safety,
             run_log: RunLog::new(metrics, options.keep_time_series),
@@ -272,6 +289,10 @@ impl World {
         self.profiler.add(Phase::Tracking, tracking);
         self.profiler.add(Phase::TireForces, forces);
         let started = self.profiler.start();
+        // Recorded traffic: kinematic targets for this step (`recorded` module doc).
+        if !self.recorded.is_empty() {
+            self.advance_recorded(t_s)?;
+        }
         self.physics.step();
         self.profiler.stop(Phase::Physics, started);
         self.step_index += 1;
@@ -301,7 +322,8 @@ impl World {
                     });
                 }
             }
-            let bodies = self.body_states(&kins);
+            let mut bodies = self.body_states(&kins);
+            bodies.extend(self.recorded.bodies());
             if need_safety {
                 self.safety
                     .check(t_s, &bodies, self.config.safety_period_s)
@@ -383,10 +405,14 @@ impl World {
                 .filter(|id| event.involves(*id))
                 .collect();
             self.event(event.describe(&names), EventLevel::Error)?;
-            self.each_observer(|o| {
-                o.on_collision(&ids);
-                Ok(())
-            })?;
+            // A collision caused by the replay is not the simulated vehicle's (module doc of
+            // the safety monitor's `recorded_pairs`): its metrics do not count it.
+            if !event.caused_by_replay {
+                self.each_observer(|o| {
+                    o.on_collision(&ids);
+                    Ok(())
+                })?;
+            }
             self.reported_collisions += 1;
         }
         while self.reported_edge_contacts < self.safety.edge_contact_events().len() {
@@ -406,8 +432,42 @@ impl World {
         Ok(())
     }
 
+    /// Every vehicle's name by id, the recorded ones after the simulated ones.
     fn names(&self) -> Vec<String> {
-        self.agents.iter().map(|a| a.spec.name.clone()).collect()
+        self.agents
+            .iter()
+            .map(|a| a.spec.name.clone())
+            .chain(self.recorded.names().map(str::to_string))
+            .collect()
+    }
+
+    /// Moves the recorded traffic from `t_s` to the end of this step and logs the handovers.
+    fn advance_recorded(&mut self, t_s: f64) -> Result<(), SimError> {
+        let simulated = if self.recorded.needs_simulated_bodies() {
+            let kins: Vec<Kinematics> = self
+                .agents
+                .iter()
+                .map(|a| a.vehicle.kinematics(&self.physics))
+                .collect();
+            self.body_states(&kins)
+        } else {
+            Vec::new()
+        };
+        let handovers = self.recorded.advance(
+            t_s,
+            // The world's clock after the step (`Self::time_s`), not t + dt rounded apart.
+            (self.step_index + 1) as f64 * self.config.dt_s,
+            &self.lanes,
+            &simulated,
+            &mut self.physics,
+        )?;
+        if !handovers.is_empty() {
+            let names = self.names();
+            for handover in handovers {
+                self.event(handover.describe(&names), EventLevel::Info)?;
+            }
+        }
+        Ok(())
     }
 
     fn log_instant(
@@ -472,6 +532,16 @@ impl World {
         self.profiler.stop(Phase::Metrics, started);
         let started = self.profiler.start();
         self.recording.on_log(t_s, &views)?;
+        if !self.recorded.is_empty() {
+            // Recorded traffic: drawn, not in the time series (`recorded` module doc).
+            let names = self.names();
+            let recorded = &bodies[self.agents.len()..];
+            let labels: Vec<String> = recorded
+                .iter()
+                .map(|b| names.get(b.id as usize).cloned().unwrap_or_default())
+                .collect();
+            self.recording.log_recorded(recorded, &labels)?;
+        }
         self.profiler.stop(Phase::Recording, started);
         Ok(())
     }

@@ -279,6 +279,7 @@ fn figures_are_png_files_and_no_temporary_file_is_left() {
         id_b: 1,
         t_contact_estimate_s: None,
         relative_speed_mps: 5.0,
+        caused_by_replay: false,
     }];
     assert_eq!(collision_marks(&rows, &crash).len(), 2);
     let series = [

@@ -146,9 +146,11 @@ pub fn run_one(
             let safety = &finished.outcome.safety;
             row.collisions = summary.collisions as u64;
             row.collided = summary.collisions > 0;
+            // The simulated vehicles' own contacts: not those caused by recorded traffic.
             row.first_contact_t_s = safety
                 .collisions
                 .iter()
+                .filter(|c| !c.caused_by_replay)
                 .map(|c| c.t_s)
                 .chain(safety.edge_contacts.iter().map(|e| e.t_s))
                 .reduce(f64::min);

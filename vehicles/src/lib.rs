@@ -17,6 +17,7 @@
 pub mod collision_groups;
 pub mod controls;
 pub mod error;
+pub mod kinematic_body;
 pub mod kinematics;
 pub mod maneuver;
 pub mod params;
@@ -31,6 +32,7 @@ pub mod wheel;
 
 pub use controls::{Controls, WHEEL_NAMES};
 pub use error::VehicleError;
+pub use kinematic_body::KinematicBox;
 pub use kinematics::Kinematics;
 pub use maneuver::{ManeuverConfig, ManeuverKind, ManeuverReport, run_maneuver};
 pub use params::{TireParams, VehicleParams};

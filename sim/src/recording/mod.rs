@@ -21,6 +21,7 @@
 //! | `world/road/merge_section` | `LineStrips2D` (static) | translucent band along the tapering stretch of each lane that ends |
 //! | `world/road/lane_ids` | `Points2D` (static) | each lane's id at half its length (only with `RecorderParams::lane_ids`) |
 //! | `world/vehicles` | `Boxes2D` | one box (length × width, axis-aligned), label and colour per vehicle |
+//! | `world/recorded_vehicles` | `Boxes2D` | one grey box and label per recorded vehicle present (recorded traffic; empty when none) |
 //! | `world/paths/<name>/planned` (+ `_points`) | `LineStrips2D`, `Points2D` | planned path |
 //! | `world/paths/<name>/received` | `LineStrips2D` | shared local paths received over V2V |
 //! | `world/fields/<name>` | `Image` (RGBA) + `Transform3D` | a potential field on the fixed colour scale, under the rest |
@@ -64,6 +65,8 @@
 mod colors;
 #[cfg(feature = "rerun")]
 mod entities;
+#[cfg(feature = "rerun")]
+mod recorded_entities;
 #[cfg(feature = "rerun")]
 mod rerun_file;
 pub mod size_estimate;

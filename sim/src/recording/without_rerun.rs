@@ -56,6 +56,15 @@ impl Recorder {
     }
 
     /// No-op.
+    pub fn log_recorded_vehicles(
+        &mut self,
+        _bodies: &[BodyState],
+        _names: &[String],
+    ) -> Result<(), RecordingError> {
+        Ok(())
+    }
+
+    /// No-op.
     pub fn log_planned_path(
         &mut self,
         _name: &str,

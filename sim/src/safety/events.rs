@@ -31,6 +31,10 @@ pub struct CollisionEvent {
     pub t_contact_estimate_s: Option<f64>,
     /// Relative speed |v_b − v_a| at `t_s` (m/s).
     pub relative_speed_mps: f64,
+    /// A recorded vehicle ran into a simulated one from behind (`recorded_pairs` module doc
+    /// of the safety monitor): not the planner's collision.
+    #[serde(default)]
+    pub caused_by_replay: bool,
 }
 
 impl CollisionEvent {
@@ -51,8 +55,13 @@ impl CollisionEvent {
             .t_contact_estimate_s
             .map(|t| format!(", first contact at {t:.3} s"))
             .unwrap_or_default();
+        let cause = if self.caused_by_replay {
+            " (a recorded vehicle ran into a simulated one from behind: caused by the replay)"
+        } else {
+            ""
+        };
         format!(
-            "collision {} / {} at t = {:.3} s{contact}, relative speed {:.2} m/s",
+            "collision {} / {} at t = {:.3} s{contact}, relative speed {:.2} m/s{cause}",
             name(self.id_a),
             name(self.id_b),
             self.t_s,
@@ -99,8 +108,21 @@ pub struct PairSafety {
 /// The safety outcome of a run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SafetySummary {
-    /// Every collision episode, in time order (pairs in id order within an instant).
+    /// Every collision episode, in time order (pairs in id order within an instant), those
+    /// caused by the replay of recorded traffic included.
     pub collisions: Vec<CollisionEvent>,
+    /// How many of [`Self::collisions`] a recorded vehicle caused by running into a simulated
+    /// one from behind (`CollisionEvent::caused_by_replay`); the planners' own are the others.
+    #[serde(default)]
+    pub collisions_caused_by_replay: u32,
+    /// Minimum exact gap between a simulated and a recorded vehicle's boxes (m), as
+    /// [`Self::min_gap_m`] over those pairs only; `None` without recorded traffic in range.
+    #[serde(default)]
+    pub min_gap_to_recorded_m: Option<f64>,
+    /// Minimum TTC between a simulated and a recorded vehicle (s); `None` if no such pair was
+    /// ever closing within the horizon.
+    #[serde(default)]
+    pub min_ttc_to_recorded_s: Option<f64>,
     /// Minimum exact gap between any two boxes (m): the smallest of [`Self::pairs`], exact
     /// whenever it is below `pair_range_m`; `None` when no pair was ever followed (fewer than
     /// two vehicles, or none ever within that range).
@@ -125,6 +147,15 @@ pub struct SafetySummary {
     pub checked_duration_s: f64,
     /// Shape casts that stopped without converging (their TTC is parry's conservative value).
     pub ttc_not_converged: u64,
+}
+
+impl SafetySummary {
+    /// The collision episodes that are not caused by the replay of recorded traffic: the
+    /// simulated vehicles' own (vehicle–vehicle only; road-edge contacts are apart).
+    pub fn own_collisions(&self) -> usize {
+        self.collisions.len()
+            - (self.collisions_caused_by_replay as usize).min(self.collisions.len())
+    }
 }
 
 /// What one pair looked like at the last checked instant.

@@ -68,6 +68,7 @@ mod edge_checks;
 mod events;
 mod pair_checks;
 mod params;
+mod recorded_pairs;
 
 use std::collections::BTreeMap;
 
@@ -85,6 +86,7 @@ pub use events::{
     SafetySummary,
 };
 pub use params::{DEFAULT_PAIR_RANGE_M, SAFETY_BOUNDS, SafetyError, SafetyParams};
+pub use recorded_pairs::recorded_is_behind;
 
 /// The bounding-circle lower bound of a pair's gap (m, ≥ 0) and its relative speed (m/s): what
 /// decides whether the pair is followed, and which exact queries it needs.
@@ -197,6 +199,8 @@ pub struct SafetyMonitor {
     checked_duration_s: f64,
     ttc_not_converged: u64,
     report: SafetyStepReport,
+    /// Ids from this one on are recorded traffic (`recorded_pairs`).
+    recorded_from: Option<VehicleId>,
 }
 
 impl SafetyMonitor {
@@ -220,6 +224,7 @@ impl SafetyMonitor {
             checked_duration_s: 0.0,
             ttc_not_converged: 0,
             report: SafetyStepReport::default(),
+            recorded_from: None,
         })
     }
 
@@ -289,7 +294,11 @@ impl SafetyMonitor {
             self.check_pair(t_s, previous_t_s, dt_s, &bodies[i], &bodies[j])?;
         }
         if self.params.check_road_edges {
-            for body in bodies {
+            let recorded_from = self.recorded_from;
+            for body in bodies
+                .iter()
+                .filter(|b| recorded_from.is_none_or(|first| b.id < first))
+            {
                 self.check_edges(t_s, previous_t_s, body)?;
             }
         }
@@ -334,7 +343,9 @@ impl SafetyMonitor {
         };
         candidates
             .into_iter()
-            .filter(|&(i, j)| self.follows(&bodies[i], &bodies[j]))
+            .filter(|&(i, j)| {
+                !self.skips_pair(bodies[i].id, bodies[j].id) && self.follows(&bodies[i], &bodies[j])
+            })
             .collect()
     }
 
@@ -399,7 +410,15 @@ impl SafetyMonitor {
         }
         let min_gap_m = min_gap.map(|(g, _)| g);
         let min_ttc_s = min_ttc.map(|(m, _)| m);
+        let (min_gap_to_recorded_m, min_ttc_to_recorded_s) = self.recorded_figures(&pairs);
         SafetySummary {
+            collisions_caused_by_replay: self
+                .collisions
+                .iter()
+                .filter(|c| c.caused_by_replay)
+                .count() as u32,
+            min_gap_to_recorded_m,
+            min_ttc_to_recorded_s,
             collisions: self.collisions.clone(),
             min_gap_m,
             t_min_gap_s: min_gap.map(|(_, t)| t),

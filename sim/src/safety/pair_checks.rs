@@ -117,6 +117,7 @@ impl SafetyMonitor {
                 id_b: b.id,
                 t_contact_estimate_s,
                 relative_speed_mps,
+                caused_by_replay: self.caused_by_replay(a, b),
             });
         }
         if !gap_is_lower_bound && gap_m < s.min_gap_m {

@@ -52,7 +52,19 @@ impl World {
             check_finite(t_s, &agent.spec.name, kin)?;
         }
         let positions: Vec<[f64; 2]> = states.iter().map(|s| [s.x_m, s.y_m]).collect();
-        let perceived = neighbours_within(&positions, self.config.perception_range_m);
+        // Recorded traffic is perceived like any unconnected vehicle (`super::recorded`): its
+        // indices follow the agents', as its ids do.
+        let recorded = self.recorded.neighbours();
+        let perceived = if recorded.is_empty() {
+            neighbours_within(&positions, self.config.perception_range_m)
+        } else {
+            let mut all = positions.clone();
+            all.extend(recorded.iter().map(|n| [n.state.x_m, n.state.y_m]));
+            let mut perceived = neighbours_within(&all, self.config.perception_range_m);
+            perceived.truncate(positions.len());
+            perceived
+        };
+        let n_agents = self.agents.len();
         self.bus.forget_stale(t_s);
         // 1. What each vehicle perceives and has received (sequential, by id).
         let mut inputs: Vec<(Vec<Neighbour>, Vec<SharedLocalPath>)> =
@@ -60,10 +72,13 @@ impl World {
         for (index, others) in perceived.iter().enumerate() {
             let neighbours: Vec<Neighbour> = others
                 .iter()
-                .map(|&j| Neighbour {
-                    id: self.agents[j].id,
-                    state: states[j],
-                    shape: self.agents[j].shape,
+                .map(|&j| match j.checked_sub(n_agents) {
+                    Some(k) => recorded[k],
+                    None => Neighbour {
+                        id: self.agents[j].id,
+                        state: states[j],
+                        shape: self.agents[j].shape,
+                    },
                 })
                 .collect();
             let agent = &self.agents[index];
