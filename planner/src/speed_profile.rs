@@ -144,21 +144,28 @@ fn time_to_cover_s(profile: &SpeedProfile, t0_s: f64, ds_m: f64) -> f64 {
 /// k + 1) is driven at the profile's speed at the time the path reaches point k, and the times
 /// follow, t_{k+1} = t_k + Δs_k / v_k; a segment starting slower than
 /// [`RETIME_SLOW_SPEED_MPS`] (a stop, a start) is timed by the profile itself
-/// (`time_to_cover_s`).
+/// (`time_to_cover_s`) and its end carries the speed at its start (the tracker reads the next
+/// point's speed as the speed to drive now; replanned every cycle, the car follows the profile
+/// one planning period late).
 pub fn retime_path(path: &mut [PathPoint], profile: &SpeedProfile) {
     let n = path.len();
+    let mut carried_mps = None;
     for k in 0..n {
         let t_s = path[k].t_s;
         let v_mps = profile
             .speed_at(t_s)
             .clamp(MIN_PROFILE_SPEED_MPS, MAX_PROFILE_SPEED_MPS);
-        path[k].speed_mps = v_mps;
+        path[k].speed_mps = carried_mps.take().unwrap_or(v_mps);
         if k + 1 < n {
             let (a, b) = (path[k], path[k + 1]);
             let ds_m = (b.x_m - a.x_m).hypot(b.y_m - a.y_m);
             path[k + 1].t_s = if v_mps >= RETIME_SLOW_SPEED_MPS {
                 t_s + ds_m / v_mps
             } else {
+                // The tracker aims at the next point's speed now: a slow segment's end carries
+                // the speed at its start, not the one the profile reaches there (after a
+                // standstill that may be seconds later).
+                carried_mps = Some(v_mps);
                 time_to_cover_s(profile, t_s, ds_m)
             };
         }
@@ -288,13 +295,16 @@ mod tests {
             path
         };
         let path = path_at(2.0);
-        for (k, p) in path.iter().enumerate().skip(1) {
-            // Point k (k metres on) at 10 + √k s, at the profile's speed then.
-            let t_s = 10.0 + (k as f64).sqrt();
-            assert!((p.t_s - t_s).abs() < 1e-9, "{p:?}");
-            assert!((p.speed_mps - 2.0 * (t_s - 10.0)).abs() < 1e-9, "{p:?}");
-        }
-        assert_eq!(path[0].speed_mps, 0.0);
+        // The first metre, from standing: covered at 11 s, its end carries the speed at its
+        // start (0: the tracker holds the car); then at the profile's speed (2 m/s at 11 s).
+        assert_eq!((path[0].speed_mps, path[1].speed_mps), (0.0, 0.0));
+        assert!((path[1].t_s - 11.0).abs() < 1e-9, "{path:?}");
+        assert!((path[2].t_s - 11.5).abs() < 1e-9, "{path:?}");
+        assert!((path[2].speed_mps - 3.0).abs() < 1e-9, "{path:?}");
+        assert!((path[3].t_s - (11.5 + 1.0 / 3.0)).abs() < 1e-9, "{path:?}");
+        // Just before the start the first point ahead still says stand; just after, go.
+        assert_eq!(path_at(9.9)[1].speed_mps, 0.0);
+        assert!((path_at(10.1)[1].speed_mps - 0.2).abs() < 1e-9);
         // Ending standing: finite, at the timing floor.
         let parked = SpeedProfile {
             points: vec![[0.0, 0.0]],
