@@ -12,9 +12,9 @@ use mergesim::sim::{RunOutcome, TimeSeriesRow};
 /// Time the car ahead starts (s).
 const RESTART_S: f64 = 20.0;
 
-/// The scenario with the ego driven by `kind` (parameter set `params`: "paper" or
-/// "mergesim").
-fn scenario(kind: PlannerKind, params: &str) -> Scenario {
+/// The scenario with the ego driven by `driver` (a TOML driver value), planner parameter set
+/// `params` ("paper" or "mergesim").
+fn scenario(driver: &str, params: &str) -> Scenario {
     let text = format!(
         r#"
 name = "stop_and_go"
@@ -43,7 +43,7 @@ lane = "upper"
 x_m = 100.0
 speed_mps = 12.0
 target_speed_mps = 12.0
-driver = {{ planner = "{planner}" }}
+driver = {driver}
 
 [[vehicles]]
 name = "lead"
@@ -54,7 +54,6 @@ speed_mps = 0.0
 target_speed_mps = 10.0
 driver = {{ prescribed = {{ path_planner = "pf-cs", speed_profile = [[0.0, 0.0], [{RESTART_S}, 0.0], [{end}, 10.0]] }} }}
 "#,
-        planner = kind.name(),
         end = RESTART_S + 5.0,
     );
     Scenario::from_toml(&text, "stop_and_go").unwrap()
@@ -77,8 +76,12 @@ fn at<'a>(rows: &[&'a TimeSeriesRow], t_s: f64) -> &'a TimeSeriesRow {
 }
 
 fn stops_and_goes(kind: PlannerKind, params: &str) {
-    let outcome = common::simulate(&scenario(kind, params), None, 0, true);
-    let what = format!("{params} / {}", kind.name());
+    let driver = format!("{{ planner = \"{}\" }}", kind.name());
+    drives_stop_and_go(&driver, &format!("{params} / {}", kind.name()), params);
+}
+
+fn drives_stop_and_go(driver: &str, what: &str, params: &str) {
+    let outcome = common::simulate(&scenario(driver, params), None, 0, true);
     assert!(
         outcome.safety.collisions.is_empty(),
         "{what}: {:?}",
@@ -151,6 +154,12 @@ fn pf_sp_stops_behind_a_standing_car_and_starts_again() {
 #[test]
 fn pf_sp_eq10_stops_behind_a_standing_car_and_starts_again() {
     stops_and_goes(PlannerKind::PfSpEq10, "mergesim");
+}
+
+/// The simulator's human driver (IDM car following) behind the same car.
+#[test]
+fn idm_stops_behind_a_standing_car_and_starts_again() {
+    drives_stop_and_go("\"idm\"", "idm", "mergesim");
 }
 
 #[test]

@@ -14,7 +14,12 @@
 //!    v_safe = −bτ + √(b²τ² + v_l² + 2b(g − s₀)) (`following` module; b = `max_accel_mps2`,
 //!    τ = `following_reaction_s`, s₀ = `following_standstill_gap_m`, the stop point's distance
 //!    behind the leader's rear), reached no faster than at b from the current speed,
-//!    cap_i = max(v_safe, v_0 − b·(i + 1)Δt_plan, 0). Behind a standing leader v_safe falls to 0
+//!    cap_i = max(v_safe, v_0 − b·(i + 1)Δt_plan, 0), v_safe from the gap now: a receding
+//!    cap, renewed every cycle (the slot-by-slot cap v_safe(g_i) at the gap g_i left after
+//!    driving the caps so far, which would keep the whole planned path behind the stop point,
+//!    was tried: through their warm-started SCP it slowed PF-SP's and PF-ISO's approach so much
+//!    that they had not stopped 20 s after starting 60 m behind; not adopted). Behind a standing
+//!    leader v_safe falls to 0
 //!    as the bumper gap g falls to s₀: near it, v_safe ≈ (g − s₀)/τ, so the gap closes on s₀
 //!    exponentially with time constant τ and never below it. When the leader drives off, g and
 //!    v_l grow and so does the cap: the vehicle starts again, never faster than Gipps allows.
@@ -84,15 +89,15 @@ pub fn stop_and_go_caps_mps(
         || leaders
             .iter()
             .any(|&(_, speed_mps)| speed_mps < threshold_mps);
-    let cap_mps = cap_behind(params, &leaders)?;
-    if !(slow || (was_active && cap_mps < req.target_speed_mps)) {
+    let cap_now_mps = cap_behind(params, &leaders)?;
+    if !(slow || (was_active && cap_now_mps < req.target_speed_mps)) {
         return None;
     }
     let decel_mps = params.max_accel_mps2 * params.step_time_s;
     let v0 = req.ego.speed_mps.max(0.0);
     Some(
         (0..params.waypoint_count)
-            .map(|i| cap_mps.max(v0 - decel_mps * (i + 1) as f64).max(0.0))
+            .map(|i| cap_now_mps.max(v0 - decel_mps * (i + 1) as f64).max(0.0))
             .collect(),
     )
 }

@@ -171,9 +171,9 @@ fn moving_traffic_has_no_stop_and_go_caps() {
     let slow = [leader(at(240.0, 3.0))];
     let caps = request(12.0, &slow).unwrap();
     assert_eq!(caps.len(), params.waypoint_count);
-    // A slow ego with a fast car ahead: caps, but far above its speed.
+    // A slow ego with a faster car ahead: caps, but above the car's speed, far above the ego's.
     let caps = request(1.0, &fast).unwrap();
-    assert!(caps.iter().all(|c| *c > 12.0), "{caps:?}");
+    assert!(caps.iter().all(|c| *c > 10.0), "{caps:?}");
     // Off with the threshold at 0.
     let off = PlannerParams {
         stop_and_go_speed_mps: 0.0,
@@ -214,13 +214,14 @@ fn moving_traffic_has_no_stop_and_go_caps() {
 }
 
 /// Kinematic roll-out (the vehicle moved exactly along its timed plans, replanning every
-/// 0.1 s): the ego at 12 m/s, 60 m behind a car standing until `restart_s`, which then
+/// 0.1 s): the ego at 12 m/s, 60 m behind a car standing until 25 s (PF-SP's risk term
+/// slows it early, then it covers the last metres at v_min), which then
 /// accelerates at 2 m/s² to 10 m/s. Returns (smallest bumper gap (m), ego speed at
 /// `restart_s` (m/s), distance the ego moved over the 3 s before `restart_s` (m), ego speed
 /// 8 s after `restart_s` (m/s)).
 fn roll_out(kind: PlannerKind, params: &PlannerParams) -> (f64, f64, f64, f64) {
     let length_m = VehicleShape::default().length_m;
-    let restart_s = 20.0;
+    let restart_s = 25.0;
     let leader_x0_m = 260.0;
     let leader_at = |t_s: f64| {
         let tau = (t_s - restart_s).max(0.0);
@@ -255,7 +256,8 @@ fn roll_out(kind: PlannerKind, params: &PlannerParams) -> (f64, f64, f64, f64) {
             waypoints: (0..=params.waypoint_count)
                 .map(|i| {
                     let t = t_s + i as f64 * params.step_time_s;
-                    let s = leader_at(t);
+                    // Standing, it does not announce when it will start.
+                    let s = if t_s < restart_s { lead } else { leader_at(t) };
                     TimedWaypoint {
                         t_s: t,
                         x_m: s.x_m,
@@ -268,7 +270,8 @@ fn roll_out(kind: PlannerKind, params: &PlannerParams) -> (f64, f64, f64, f64) {
         assert_finite_and_non_negative(&plan, kind.name());
         if std::env::var("SG_DEBUG").is_ok() && k % 5 == 0 {
             eprintln!(
-                "t {t_s:.1} x {:.2} v {:.2} gap {:.2} fb {:?} v1 {:.3} y_end {:.2}",
+                "{} t {t_s:.1} x {:.2} v {:.2} gap {:.2} fb {:?} v1 {:.3} y_end {:.2}",
+                kind.name(),
                 ego.x_m,
                 ego.speed_mps,
                 lead.x_m - ego.x_m - length_m,
