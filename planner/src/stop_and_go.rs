@@ -76,6 +76,16 @@ pub fn stop_and_go_caps_mps(
     if threshold_mps <= 0.0 {
         return None;
     }
+    // Cheap test first (moving traffic costs one comparison per neighbour): nobody slow
+    // around and no stop-and-go cycle before, nothing to do.
+    let anyone_slow = req.ego.speed_mps < threshold_mps
+        || req
+            .neighbours
+            .iter()
+            .any(|n| n.id != req.ego_id && n.state.speed_mps < threshold_mps);
+    if !(anyone_slow || was_active) {
+        return None;
+    }
     let leaders = corridor_leaders_in_lane_frame(
         params,
         road,
