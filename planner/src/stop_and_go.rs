@@ -39,7 +39,10 @@
 //!    and the target-speed term ½w2(v_i − V_target)² falls with v_i, so where the cap is below
 //!    v_min the best speed is the cap itself (the interaction term is not consulted on such a
 //!    slot: the cap is the binding constraint). Where the cap is above v_min it is an ordinary
-//!    upper bound inside the optimisation (V_i^max), so the answer is Eq. 10's.
+//!    upper bound inside the optimisation (V_i^max), so the answer is Eq. 10's. Lowering the
+//!    variables' bound to v_min/10 in such cycles (Δs/v kept exact) was tried and not adopted:
+//!    PF-ISO's interaction term then held the speed in (0.2, 0.5) m/s, above the tracker's
+//!    stop speed, and the car crept 0.30 m over 3 s at the stop point instead of standing.
 //! 4. **Times** ([`segment_time_s`]). A segment planned at a speed below
 //!    [`STANDSTILL_TIMING_SPEED_MPS`] (1 cm/s) is timed as if driven at that speed,
 //!    t_i = t_{i−1} + Δs_i / max(v_i, 0.01 m/s): every time is finite (a stopped vehicle's
