@@ -122,6 +122,9 @@ pub struct PlanStats {
     /// Whether PF-ISO planned without any fresh shared path around it (V2V lost), with
     /// `v2v_loss_fallback = risk-aware-following` (`following` module).
     pub v2v_degraded: bool,
+    /// Whether the speeds were capped for stop and go (`stop_and_go` module): only then may
+    /// they be below `min_speed_mps`.
+    pub stop_and_go: bool,
 }
 
 /// A potential-field planner of one vehicle. Holds the last good plan (for the fallback and
@@ -436,6 +439,7 @@ impl PfPlanner {
         // None in moving traffic, which is then planned exactly as without it.
         let stop_caps_mps = stop_and_go_caps_mps(params, &self.road, req, &points, self.stopping);
         self.stopping = stop_caps_mps.is_some();
+        self.stats.stop_and_go = self.stopping;
 
         // V2V lost (`following` module): a PF-ISO cycle without any fresh shared path around
         // plans its speeds as PF-SP, capped at the safe following speed.
