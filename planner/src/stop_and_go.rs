@@ -19,8 +19,7 @@
 //!    driving the caps so far, which would keep the whole planned path behind the stop point,
 //!    was tried: through their warm-started SCP it slowed PF-SP's and PF-ISO's approach so much
 //!    that they had not stopped 20 s after starting 60 m behind; not adopted). Behind a standing
-//!    leader v_safe falls to 0
-//!    as the bumper gap g falls to s₀: near it, v_safe ≈ (g − s₀)/τ, so the gap closes on s₀
+//!    leader v_safe falls to 0 as the bumper gap g falls to s₀: near it, v_safe ≈ (g − s₀)/τ, so the gap closes on s₀
 //!    exponentially with time constant τ and never below it. When the leader drives off, g and
 //!    v_l grow and so does the cap: the vehicle starts again, never faster than Gipps allows.
 //!    Once on, the cap stays on while Gipps' speed is below V_target (the vehicle ahead still
@@ -34,8 +33,9 @@
 //! 3. **Eq. 10 with speeds below v_min**. The optimisation itself keeps its decision variables
 //!    in [v_min, max(V_i^max, v_min)] (`min_speed_mps`, so Δs/v stays finite and the solver
 //!    unchanged); afterwards a speed above its cap is lowered to the cap, which may be below
-//!    v_min, down to 0 ([`apply_caps`]). This is the exact solution of Eq. 10 with the travel
-//!    time floored at v_min, Δs_i / max(v_i, v_min): on [0, v_min] that travel time is constant
+//!    v_min, down to 0 ([`apply_caps`]). Slot by slot this is the solution of Eq. 10 with the
+//!    travel time floored at v_min, Δs_i / max(v_i, v_min) (the acceleration bound couples the
+//!    slots; the caps, falling at no more than b, meet it): on [0, v_min] that time is constant
 //!    and the target-speed term ½w2(v_i − V_target)² falls with v_i, so where the cap is below
 //!    v_min the best speed is the cap itself (the interaction term is not consulted on such a
 //!    slot: the cap is the binding constraint). Where the cap is above v_min it is an ordinary
