@@ -101,17 +101,16 @@ fn meeting_x_m(ego: &VehicleState, ego_shape: &VehicleShape, n: &Neighbour) -> f
     n.state.x_m + n.state.speed_mps.max(0.0) * (gap_m / closing_mps)
 }
 
-/// The safe-following cap (m/s) of a vehicle at `ego` (shape `ego_shape`) planning along
-/// `path` (world points from its position on), behind the nearest neighbour in its corridor;
-/// `None` when no neighbour is in it.
-pub fn following_cap_mps(
+/// The vehicles ahead of `ego` (shape `ego_shape`) in its corridor along `path` (world points
+/// from its position on; module doc), each as (bumper gap along X (m), speed (m/s)).
+pub fn corridor_leaders(
     params: &PlannerParams,
     ego_id: VehicleId,
     ego: &VehicleState,
     ego_shape: &VehicleShape,
     neighbours: &[Neighbour],
     path: &[[f64; 2]],
-) -> Option<f64> {
+) -> Vec<(f64, f64)> {
     neighbours
         .iter()
         .filter(|n| n.id != ego_id && n.state.x_m > ego.x_m)
@@ -124,17 +123,40 @@ pub fn following_cap_mps(
             };
             in_corridor_at(n.state.x_m) || in_corridor_at(meeting_x_m(ego, ego_shape, n))
         })
-        .map(|n| {
-            safe_following_speed_mps(params, bumper_gap_m(ego, ego_shape, n), n.state.speed_mps)
-        })
+        .map(|n| (bumper_gap_m(ego, ego_shape, n), n.state.speed_mps))
+        .collect()
+}
+
+/// The safe-following cap (m/s) of a vehicle at `ego` (shape `ego_shape`) planning along
+/// `path` (world points from its position on), behind the nearest neighbour in its corridor;
+/// `None` when no neighbour is in it.
+pub fn following_cap_mps(
+    params: &PlannerParams,
+    ego_id: VehicleId,
+    ego: &VehicleState,
+    ego_shape: &VehicleShape,
+    neighbours: &[Neighbour],
+    path: &[[f64; 2]],
+) -> Option<f64> {
+    cap_behind(
+        params,
+        &corridor_leaders(params, ego_id, ego, ego_shape, neighbours, path),
+    )
+}
+
+/// The smallest safe-following speed behind `leaders` ((gap, speed) pairs); `None` if empty.
+pub fn cap_behind(params: &PlannerParams, leaders: &[(f64, f64)]) -> Option<f64> {
+    leaders
+        .iter()
+        .map(|&(gap_m, speed_mps)| safe_following_speed_mps(params, gap_m, speed_mps))
         .reduce(f64::min)
 }
 
-/// [`following_cap_mps`] on a road of lanes: the ego, the neighbours and the path are first
+/// [`corridor_leaders`] on a road of lanes: the ego, the neighbours and the path are first
 /// mapped into the frame of the ego's lane (x → s along it, y → d across it), so "ahead", the
 /// bumper gap and the corridor are measured along the road, curved or not (on a straight road
 /// along +x the same figures as in world coordinates).
-pub fn following_cap_in_lane_frame_mps(
+pub fn corridor_leaders_in_lane_frame(
     params: &PlannerParams,
     road: &LaneRoadGeometry,
     ego_id: VehicleId,
@@ -142,7 +164,7 @@ pub fn following_cap_in_lane_frame_mps(
     ego_shape: &VehicleShape,
     neighbours: &[Neighbour],
     path: &[[f64; 2]],
-) -> Option<f64> {
+) -> Vec<(f64, f64)> {
     let lane = road.lane_index_at([ego.x_m, ego.y_m]);
     let to_frame = |p: [f64; 2]| {
         let j = road.jacobian(lane, p);
@@ -161,7 +183,23 @@ pub fn following_cap_in_lane_frame_mps(
         })
         .collect();
     let path_f: Vec<[f64; 2]> = path.iter().map(|p| to_frame(*p)).collect();
-    following_cap_mps(params, ego_id, &ego_f, ego_shape, &neighbours_f, &path_f)
+    corridor_leaders(params, ego_id, &ego_f, ego_shape, &neighbours_f, &path_f)
+}
+
+/// [`following_cap_mps`] on a road of lanes ([`corridor_leaders_in_lane_frame`]).
+pub fn following_cap_in_lane_frame_mps(
+    params: &PlannerParams,
+    road: &LaneRoadGeometry,
+    ego_id: VehicleId,
+    ego: &VehicleState,
+    ego_shape: &VehicleShape,
+    neighbours: &[Neighbour],
+    path: &[[f64; 2]],
+) -> Option<f64> {
+    cap_behind(
+        params,
+        &corridor_leaders_in_lane_frame(params, road, ego_id, ego, ego_shape, neighbours, path),
+    )
 }
 
 #[cfg(test)]

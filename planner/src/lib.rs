@@ -32,6 +32,7 @@ pub mod road;
 pub mod road_field;
 pub mod speed_optimisation;
 pub mod speed_profile;
+pub mod stop_and_go;
 pub mod types;
 
 pub use error::PlannerError;

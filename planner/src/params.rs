@@ -138,8 +138,10 @@ pub struct PlannerParams {
     // ---------------------------------------------------------------- Eq. 10 (speeds)
     /// V_limit, the speed limit (m/s).
     pub speed_limit_mps: f64,
-    /// v_min, lower bound on every speed (m/s, > 0): keeps the travel-time term Δs/v finite.
-    /// The paper's bound 0 ≤ v_i is read as v_min ≤ v_i; a full stop is outside this problem.
+    /// v_min, lower bound of Eq. 10's decision variables (m/s, > 0): keeps the travel-time term
+    /// Δs/v finite. The paper's bound 0 ≤ v_i is read as v_min ≤ v_i in moving traffic; a stop
+    /// (speeds below v_min, down to 0) is the `stop_and_go` module's cap, with the travel time
+    /// floored at v_min (`stop_and_go_speed_mps`).
     pub min_speed_mps: f64,
     /// w1, weight of the travel time Σ Δs_i / v_i (1/s).
     pub travel_time_weight: f64,
@@ -249,6 +251,16 @@ pub struct PlannerParams {
     /// of the safety monitor.
     pub following_lateral_margin_m: f64,
 
+    // ---------------------------------------------------------------- stop and go
+    /// Speed below which stop and go is handled (m/s; `stop_and_go` module): in a cycle where
+    /// the planning vehicle or a vehicle ahead in its corridor is slower than this, every
+    /// planner caps its speeds at Gipps' safe-following speed behind the vehicles in its
+    /// corridor (`following_reaction_s`, `following_standstill_gap_m`), and the speeds may go
+    /// below `min_speed_mps` down to 0. 5 m/s: ten times `min_speed_mps` and half the slowest
+    /// speed of the built-in scenarios (10 m/s), so moving traffic is planned as before, bit for
+    /// bit (docs/parameters.md). 0 turns it off (the planners then creep at `min_speed_mps`).
+    pub stop_and_go_speed_mps: f64,
+
     // ---------------------------------------------------------------- faults
     /// Comfortable deceleration of the fallback plan (m/s², positive).
     pub fallback_decel_mps2: f64,
@@ -339,6 +351,7 @@ impl Default for PlannerParams {
             following_reaction_s: 1.0,
             following_standstill_gap_m: 2.0,
             following_lateral_margin_m: 0.5,
+            stop_and_go_speed_mps: 5.0,
             fallback_decel_mps2: 2.0,
         }
     }
@@ -408,6 +421,7 @@ pub const PLANNER_BOUNDS: &[Bound] = &[
     Bound::closed("following_reaction_s", 0.0, 5.0, "s"),
     Bound::closed("following_standstill_gap_m", 0.0, 20.0, "m"),
     Bound::closed("following_lateral_margin_m", 0.0, 5.0, "m"),
+    Bound::closed("stop_and_go_speed_mps", 0.0, 30.0, "m/s"),
     Bound::above("fallback_decel_mps2", 0.0, 20.0, "m/s²"),
 ];
 
@@ -485,6 +499,7 @@ impl PlannerParams {
                 "following_lateral_margin_m",
                 self.following_lateral_margin_m,
             ),
+            ("stop_and_go_speed_mps", self.stop_and_go_speed_mps),
             ("fallback_decel_mps2", self.fallback_decel_mps2),
         ]
     }

@@ -36,6 +36,7 @@ pub use crate::request::{PlanRequest, validate_request};
 use crate::speed_optimisation::{
     Aggregate, SpeedOptimiser, SpeedProblem, SpeedTerm, friction_speed_limits,
 };
+use crate::stop_and_go::{apply_caps, segment_time_s, stop_and_go_caps_mps};
 use crate::types::{FallbackReason, PathPoint, Plan, SharedLocalPath};
 use mergesim_types::lanes::LaneRoad;
 use std::sync::Arc;
@@ -121,6 +122,9 @@ pub struct PlanStats {
     /// Whether PF-ISO planned without any fresh shared path around it (V2V lost), with
     /// `v2v_loss_fallback = risk-aware-following` (`following` module).
     pub v2v_degraded: bool,
+    /// Whether the speeds were capped for stop and go (`stop_and_go` module): only then may
+    /// they be below `min_speed_mps`.
+    pub stop_and_go: bool,
 }
 
 /// A potential-field planner of one vehicle. Holds the last good plan (for the fallback and
@@ -140,6 +144,8 @@ pub struct PfPlanner {
     /// Time of the first planning cycle (s): V2V counts as lost only once a shared path could
     /// have arrived (`max_shared_path_age_s` after it).
     first_plan_s: Option<f64>,
+    /// Whether the last cycle was a stop-and-go cycle (`stop_and_go` module).
+    stopping: bool,
 }
 
 fn non_finite(what: &str) -> PlannerError {
@@ -193,6 +199,7 @@ impl PfPlanner {
             optimiser: SpeedOptimiser::new(),
             stats: PlanStats::default(),
             first_plan_s: None,
+            stopping: false,
         })
     }
 
@@ -428,6 +435,11 @@ impl PfPlanner {
         }
         let line = Polyline::with_start([req.ego.x_m, req.ego.y_m], points.iter().copied());
         let segment_lengths_m = line.segment_lengths_m();
+        // Stop and go (`stop_and_go` module): caps down to 0 behind a slow or stopped vehicle;
+        // None in moving traffic, which is then planned exactly as without it.
+        let stop_caps_mps = stop_and_go_caps_mps(params, &self.road, req, &points, self.stopping);
+        self.stopping = stop_caps_mps.is_some();
+        self.stats.stop_and_go = self.stopping;
 
         // V2V lost (`following` module): a PF-ISO cycle without any fresh shared path around
         // plans its speeds as PF-SP, capped at the safe following speed.
@@ -446,11 +458,17 @@ impl PfPlanner {
 
         // Speeds (Eq. 10, or PF-SP's risk-aware problem).
         let speeds_mps = match speed_kind {
-            PlannerKind::PfCs => vec![
-                req.target_speed_mps
-                    .clamp(params.min_speed_mps, params.speed_limit_mps);
-                n
-            ],
+            PlannerKind::PfCs => {
+                let mut speeds_mps = vec![
+                    req.target_speed_mps
+                        .clamp(params.min_speed_mps, params.speed_limit_mps);
+                    n
+                ];
+                if let Some(caps_mps) = &stop_caps_mps {
+                    apply_caps(&mut speeds_mps, caps_mps);
+                }
+                speeds_mps
+            }
             kind => {
                 let mut max_speeds_mps = friction_speed_limits(
                     |xi| cubic.curvature_per_m(xi),
@@ -490,6 +508,9 @@ impl PfPlanner {
                         *v = v.min(cap_mps.max(from_now).max(params.min_speed_mps));
                     }
                 }
+                if let Some(caps_mps) = &stop_caps_mps {
+                    apply_caps(&mut max_speeds_mps, caps_mps);
+                }
                 let (term, weight, count) = self.speed_term(kind, req, &line, &waypoints);
                 self.stats.interacting_vehicles = count;
                 // Warm start: the last good plan's speeds at the same absolute times.
@@ -518,7 +539,12 @@ impl PfPlanner {
                     .map_err(|e| fail(e, Some(waypoints.clone())))?;
                 self.stats.speed_solves = solution.solves;
                 self.stats.speed_stopped_at_iteration_cap = solution.stopped_at_iteration_cap;
-                solution.speeds_mps
+                let mut speeds_mps = solution.speeds_mps;
+                if let Some(caps_mps) = &stop_caps_mps {
+                    // Below v_min, the cap itself (`stop_and_go` module doc, item 3).
+                    apply_caps(&mut speeds_mps, caps_mps);
+                }
+                speeds_mps
             }
         };
 
@@ -535,7 +561,11 @@ impl PfPlanner {
             t_s,
         });
         for (k, p) in points.iter().enumerate() {
-            t_s += segment_lengths_m[k] / speeds_mps[k];
+            t_s += if stop_caps_mps.is_some() {
+                segment_time_s(segment_lengths_m[k], speeds_mps[k])
+            } else {
+                segment_lengths_m[k] / speeds_mps[k]
+            };
             path.push(PathPoint {
                 x_m: p[0],
                 y_m: p[1],

@@ -65,7 +65,8 @@ proptest! {
             for p in &plan.path[1..] {
                 prop_assert!(p.speed_mps >= 0.0 && p.speed_mps <= params.speed_limit_mps + 1e-9,
                     "speed {} out of bounds", p.speed_mps);
-                if plan.fallback.is_none() {
+                // Below v_min only under the stop-and-go cap (down to 0).
+                if plan.fallback.is_none() && !planner.last_stats().stop_and_go {
                     prop_assert!(p.speed_mps >= params.min_speed_mps - 1e-9);
                 }
             }
