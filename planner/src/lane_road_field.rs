@@ -286,6 +286,34 @@ impl LaneRoadGeometry {
             .unwrap_or(lane)
     }
 
+    /// The lane indices of a route given as lane ids (ids the road does not have are dropped).
+    pub fn route_indices(&self, route: &[LaneId]) -> Vec<usize> {
+        route
+            .iter()
+            .filter_map(|id| self.road.lanes().iter().position(|l| l.id() == *id))
+            .collect()
+    }
+
+    /// The target lane of a vehicle in lane `lane` that follows `route` (lane indices in driving
+    /// order, e.g. to a goal): where its lane is on the route, the route's next lane if that is
+    /// a neighbour across a divider (the lane change the route asks for), else its own lane;
+    /// where its lane is not on the route, a neighbour on the route; otherwise (or with an
+    /// empty route) the lane-end rule, [`LaneRoadGeometry::target_lane`].
+    pub fn route_target_lane(&self, lane: usize, route: &[usize]) -> usize {
+        let neighbours = |a: usize, b: usize| self.side_of_neighbour(a, b).is_some();
+        if let Some(k) = route.iter().rposition(|&r| r == lane) {
+            return match route.get(k + 1) {
+                Some(&next) if neighbours(lane, next) => next,
+                _ => lane,
+            };
+        }
+        route
+            .iter()
+            .copied()
+            .find(|&r| neighbours(lane, r))
+            .unwrap_or_else(|| self.target_lane(lane))
+    }
+
     /// The dividers that a vehicle in `state` (half-width `half_width_m`) sees as walls under
     /// the lane-end rule, with the sign that makes δ = sign·(d − d_div) positive on its side,
     /// and the lane it is settled in (to pass back on its next cycle as `settled_lane`).

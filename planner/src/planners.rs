@@ -36,8 +36,8 @@ pub use crate::request::{PlanRequest, validate_request};
 use crate::speed_optimisation::{
     Aggregate, SpeedOptimiser, SpeedProblem, SpeedTerm, friction_speed_limits,
 };
-use crate::types::{FallbackReason, PathPoint, Plan, SharedLocalPath};
-use mergesim_types::lanes::LaneRoad;
+use crate::types::{FallbackReason, PathPoint, Plan, SharedLocalPath, VehicleState};
+use mergesim_types::lanes::{LaneId, LaneRoad};
 use std::sync::Arc;
 
 /// Which planner a vehicle runs.
@@ -140,6 +140,9 @@ pub struct PfPlanner {
     /// Time of the first planning cycle (s): V2V counts as lost only once a shared path could
     /// have arrived (`max_shared_path_age_s` after it).
     first_plan_s: Option<f64>,
+    /// The lanes (indices) the vehicle drives along, e.g. to its goal
+    /// ([`PfPlanner::with_route`]); empty: the lane-end rule.
+    route: Vec<usize>,
 }
 
 fn non_finite(what: &str) -> PlannerError {
@@ -193,7 +196,29 @@ impl PfPlanner {
             optimiser: SpeedOptimiser::new(),
             stats: PlanStats::default(),
             first_plan_s: None,
+            route: Vec::new(),
         })
+    }
+
+    /// The planner following `route` (lane ids in driving order, e.g. the shortest route to a
+    /// goal): Eq. 1's target lane is the route's
+    /// ([`LaneRoadGeometry::route_target_lane`]) instead of the lane-end rule's.
+    pub fn with_route(mut self, route: &[LaneId]) -> Self {
+        self.route = self.road.route_indices(route);
+        self
+    }
+
+    /// Eq. 1's target on the route, if the planner has one.
+    fn follow_route(&self, field: &mut PotentialField<'_>, ego: &VehicleState) {
+        if self.route.is_empty() {
+            return;
+        }
+        let p = [ego.x_m, ego.y_m];
+        let target = self
+            .road
+            .route_target_lane(self.road.lane_index_at(p), &self.route);
+        field.target_lane = target;
+        field.target_s_m = self.road.s_m(target, p) + self.params.target_lookahead_m;
     }
 
     /// The planner kind.
@@ -242,6 +267,7 @@ impl PfPlanner {
             &req.ego_shape,
             req.neighbours,
         );
+        self.follow_route(&mut field, &req.ego);
         if self.params.lane_end_walls {
             field.road.walls = self
                 .road
@@ -393,6 +419,7 @@ impl PfPlanner {
             &req.ego_shape,
             req.neighbours,
         );
+        self.follow_route(&mut field, &req.ego);
         field.road.walls = walls;
         let step_m = params.step_length_m(req.ego.speed_mps);
         let time_per_step_s = if params.predict_obstacles_in_path {

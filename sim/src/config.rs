@@ -4,9 +4,11 @@ use planner::{MergeRoad, PlannerParams, SpeedProfile};
 use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
 
+use mergesim_types::lanes::LaneId;
 use mergesim_types::{Bound, bounds};
 
 use crate::error::SimError;
+use crate::goal::Goal;
 use crate::idm::IdmParams;
 use crate::recorded_traffic::RecordedTraffic;
 use crate::road_config::{LaneRoadConfig, StartLane, build_lane_road};
@@ -233,15 +235,18 @@ pub struct VehicleSpec {
     pub name: String,
     /// Vehicle preset (`bmw_320i`, `ford_escort`, `vw_vanagon`).
     pub preset: String,
-    /// Starting lane: `"lower"` / `"upper"` (the merge road's lanes 2 and 1) or a lane id.
+    /// Starting lane: `"lower"` / `"upper"` (the merge road's lanes 2 and 1) or a lane id
+    /// (`lanelet = ID` on a CommonRoad road: a lanelet's id is its lane's).
+    #[serde(alias = "lanelet")]
     pub lane: StartLane,
     /// Initial longitudinal position of the centre of gravity (m): on the straight `[sim.road]`
     /// merge road its x; on a road of lanes (`[sim.lane_road]`) its arc length s along the start
-    /// lane's centreline, from the lane's first vertex.
+    /// lane's centreline, from the lane's first vertex (`s_m` is read as this).
+    #[serde(alias = "s_m")]
     pub x_m: f64,
     /// Lateral offset from the lane centre (m, positive to the left; on a road of lanes the
-    /// lane-frame offset d).
-    #[serde(default)]
+    /// lane-frame offset d; `d_m` is read as this).
+    #[serde(default, alias = "d_m")]
     pub y_offset_m: f64,
     /// Initial speed (m/s).
     pub speed_mps: f64,
@@ -252,6 +257,15 @@ pub struct VehicleSpec {
     /// Whether it sends and receives shared local paths.
     #[serde(default = "default_true")]
     pub connected: bool,
+    /// Its goal (`crate::goal`): checked every log period; `goal_reached` and `goal_time_s` in
+    /// the outcome. A CommonRoad scenario's ego gets its planning problem's goal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goal: Option<Goal>,
+    /// The lanes its planner drives along, in order (`crate::route`; a road of lanes only):
+    /// a potential-field planner targets the route's lane at or after its own. None: the
+    /// lane-end rule (its own lane, unless it ends).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub route: Option<Vec<LaneId>>,
 }
 
 fn default_true() -> bool {
@@ -373,7 +387,16 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
                     ),
                 ));
             }
+            if let Some(route) = &spec.route {
+                check_route(lanes, spec, route)?;
+            }
             continue;
+        }
+        if spec.route.is_some() {
+            return Err(SimError::InvalidField {
+                field: field("route"),
+                message: "a route needs a road of lanes ([sim.lane_road])".into(),
+            });
         }
         if spec.lane.merge_lane().is_none() {
             return Err(SimError::InvalidField {
@@ -396,6 +419,35 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
                     config.road.start_x_m, config.road.end_x_m
                 ),
             ));
+        }
+    }
+    Ok(())
+}
+
+/// A route starts at the vehicle's lane and goes on, lane by lane, to a successor or a
+/// same-direction neighbour (`crate::route::next_lanes`).
+fn check_route(
+    lanes: &mergesim_types::lanes::LaneRoad,
+    spec: &VehicleSpec,
+    route: &[LaneId],
+) -> Result<(), SimError> {
+    let field = format!("vehicles[{}].route", spec.name);
+    if route.first() != Some(&spec.lane.id()) {
+        return Err(SimError::InvalidField {
+            field,
+            message: format!("a route must start at the vehicle's lane {}", spec.lane),
+        });
+    }
+    for pair in route.windows(2) {
+        if !crate::route::next_lanes(lanes, pair[0]).contains(&pair[1]) {
+            return Err(SimError::InvalidField {
+                field,
+                message: format!(
+                    "lane {} does not follow lane {} (neither a successor nor a same-direction \
+                     neighbour)",
+                    pair[1], pair[0]
+                ),
+            });
         }
     }
     Ok(())
