@@ -128,6 +128,11 @@ impl SimConfig {
         build_lane_road(&self.road, self.lane_road.as_ref())
     }
 
+    /// The CommonRoad file the road comes from, if it does (`crate::road_config`).
+    pub fn commonroad_road(&self) -> Option<&crate::road_config::CommonRoadRoad> {
+        self.lane_road.as_ref()?.commonroad.as_ref()
+    }
+
     /// True if the road is the `[sim.road]` merge road, straight (no `lane_road`): vehicle
     /// positions are then world x (`x_m`) and offsets from the lane centre (`y_offset_m`).
     pub fn is_straight_merge_road(&self) -> bool {
@@ -350,14 +355,27 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
         if let Driver::Prescribed { speed_profile, .. } = &spec.driver {
             speed_profile.validate(&field("driver.prescribed"))?;
         }
+        // On a CommonRoad road the offset is bounded by the lanelet (below), not by ±1 m: a
+        // recorded initial state may lie anywhere across its lanelet.
+        let on_commonroad = config.commonroad_road().is_some();
+        let bounds_list: &[Bound] = if on_commonroad {
+            &VEHICLE_BOUNDS[1..]
+        } else {
+            VEHICLE_BOUNDS
+        };
+        let values = [
+            ("y_offset_m", spec.y_offset_m),
+            ("speed_mps", spec.speed_mps),
+            ("target_speed_mps", spec.target_speed_mps),
+        ];
         bounds::check_all(
             &format!("vehicles[{}]", spec.name),
-            VEHICLE_BOUNDS,
-            &[
-                ("y_offset_m", spec.y_offset_m),
-                ("speed_mps", spec.speed_mps),
-                ("target_speed_mps", spec.target_speed_mps),
-            ],
+            bounds_list,
+            if on_commonroad {
+                &values[1..]
+            } else {
+                &values[..]
+            },
         )?;
         if let Some(lanes) = lanes.as_ref() {
             let Some(lane) = lanes.lane(spec.lane.id()) else {
@@ -386,6 +404,23 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
                         lane.length_m()
                     ),
                 ));
+            }
+            if on_commonroad {
+                let (right_m, left_m) = (lane.right_d_m(spec.x_m), lane.left_d_m(spec.x_m));
+                if !(spec.y_offset_m.is_finite()
+                    && right_m <= spec.y_offset_m
+                    && spec.y_offset_m <= left_m)
+                {
+                    return Err(SimError::invalid(
+                        field("y_offset_m"),
+                        spec.y_offset_m,
+                        format!(
+                            "the centre must lie on lanelet {}: at s = {:.3} m its offset d must \
+                             lie in [{right_m:.3}, {left_m:.3}] m",
+                            spec.lane, spec.x_m
+                        ),
+                    ));
+                }
             }
             if let Some(route) = &spec.route {
                 check_route(lanes, spec, route)?;

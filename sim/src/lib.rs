@@ -43,5 +43,5 @@ pub use mergesim_types::{
 pub use observer::{PlanView, TickObserver, VehicleView};
 pub use outcome::{PlannerStats, RunOutcome, TimeSeriesRow};
 pub use registry::{BehaviourFactory, BehaviourRegistry, FactoryInput};
-pub use road_config::{LaneRoadConfig, StartLane};
+pub use road_config::{CommonRoadRoad, LaneRoadConfig, StartLane};
 pub use world::{RunOptions, World};
