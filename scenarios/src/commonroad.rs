@@ -388,13 +388,24 @@ impl Scenario {
         } else {
             cr.benchmark_id.clone()
         };
+        let route = match &ego.route {
+            Some(r) => format!(
+                ", route along lanelets {}",
+                r.iter()
+                    .map(|l| l.to_string())
+                    .collect::<Vec<_>>()
+                    .join(" → ")
+            ),
+            None => String::new(),
+        };
         let mut scenario = Scenario {
             description: format!(
                 "CommonRoad {name}: {} lanelets, {} recorded vehicles ({mode}), the ego of \
-                 planning problem {}",
+                 planning problem {} on lanelet {}{route}",
                 cr.lanelets.len(),
                 traffic.vehicles.len(),
-                pp.id
+                pp.id,
+                ego.lane
             ),
             name,
             params: planner::ParameterSet::default(),
