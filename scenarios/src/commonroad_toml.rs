@@ -176,6 +176,31 @@ pub(crate) fn apply(
     Ok(())
 }
 
+/// Reads the file of a `[sim.lane_road] commonroad = { file = …, recorded_traffic = … }`
+/// source (relative to `base`): keeps its lanes and fills the recorded traffic.
+pub(crate) fn read_lane_road_source(
+    scenario: &mut Scenario,
+    base: Option<&Path>,
+) -> Result<(), ScenarioError> {
+    let Some(road) = scenario
+        .sim
+        .lane_road
+        .as_mut()
+        .and_then(|c| c.commonroad.as_mut())
+    else {
+        return Ok(());
+    };
+    let path = match base {
+        Some(dir) if road.file.is_relative() => dir.join(&road.file),
+        _ => road.file.clone(),
+    };
+    let (cr, _lanes) = mergesim_commonroad::read_with_road(&path)?;
+    let mode = road.recorded_traffic;
+    *road = CommonRoadRoad::of(crate::commonroad::absolute(&path), mode, &cr);
+    scenario.sim.recorded_traffic = crate::commonroad::recorded_traffic(&path, &cr, mode, 0.0)?;
+    Ok(())
+}
+
 /// A refusal naming a vehicle field by the name the TOML wrote (`lanelet`, `s_m`, `d_m` for
 /// `lane`, `x_m`, `y_offset_m`), at that key's line.
 pub(crate) fn aliased(

@@ -179,6 +179,10 @@ impl Scenario {
         let mut scenario: Scenario = toml::from_str(text_read).map_err(parse_error)?;
         if let Some(source) = &source {
             crate::commonroad_toml::apply(&mut scenario, source, base, origin)?;
+        } else if scenario.sim.commonroad_road().is_some() {
+            // `[sim.lane_road] commonroad = { file = … }` (e.g. a CommonRoad scenario written
+            // out by `to_toml`): the same file reading.
+            crate::commonroad_toml::read_lane_road_source(&mut scenario, base)?;
         }
         // The [sim.planner] values as written, to apply on top of the parameter set.
         scenario.planner_overrides = table

@@ -224,3 +224,14 @@ fn commonroad_road_keys_are_checked() {
     let e = Scenario::from_toml(&missing, "t.toml").unwrap_err().to_string();
     assert!(e.contains("no/such/file.xml"), "{e}");
 }
+
+#[test]
+fn a_commonroad_scenario_written_as_toml_reads_back_the_same() {
+    let s = load("USA_US101-4_1_T-1.xml");
+    let text = s.to_toml().unwrap();
+    let back = Scenario::from_toml(&text, "back.toml").unwrap_or_else(|e| panic!("{e}\n{text}"));
+    assert_eq!(back.vehicles, s.vehicles);
+    assert_eq!(back.sim.duration_s, s.sim.duration_s);
+    assert_eq!(back.sim.recorded_traffic, s.sim.recorded_traffic);
+    assert_eq!(back.sim.lane_road, s.sim.lane_road);
+}
