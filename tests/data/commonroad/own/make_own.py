@@ -113,3 +113,14 @@ body = "\n".join([
                      "      <velocity><intervalStart>10.0</intervalStart><intervalEnd>20.0</intervalEnd></velocity>"),
 ])
 open("y_merge.xml", "w").write(doc("OWN_YMerge-1", body))
+
+# A fork: a main lanelet 20 (100 m along y = 0) with two successors: lanelet 21 straight on
+# (200 m) and an exit lanelet 22 leaving to the right (y = −20 (x'/150)², x' from the fork,
+# 150 m along x). No obstacle, no planning problem: scenario TOMLs place their own cars.
+exit_ramp = [(100.0 + x, -20.0 * (x / 150.0) ** 2) for x in range(0, 151, 5)]
+body = "\n".join([
+    lanelet(20, [(0.0, 0.0), (100.0, 0.0)], succ=(21, 22)),
+    lanelet(21, [(100.0, 0.0), (300.0, 0.0)], pred=(20,)),
+    lanelet(22, exit_ramp, pred=(20,), kind="exitRamp"),
+])
+open("fork.xml", "w").write(doc("OWN_Fork-1", body))
