@@ -257,3 +257,38 @@ fn too_many_lanelets_exit_2() {
         &[format!("{} lanelets", mergesim_commonroad::MAX_LANELETS + 1)],
     );
 }
+
+#[test]
+fn at_a_fork_the_route_chooses_the_branch() {
+    let fork = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/commonroad/own/fork.xml"
+    );
+    let dir = scratch("fork_route");
+    let lane_changes = |route: &str| -> Vec<String> {
+        let text = format!(
+            "name = \"fork\"\n[sim]\nduration_s = 14.0\n[sim.road]\ncommonroad = \"{fork}\"\n\n[[vehicles]]\nname = \"ego\"\npreset = \"bmw_320i\"\nlanelet = 20\ns_m = 10.0\nspeed_mps = 15.0\ntarget_speed_mps = 15.0\ndriver = {{ planner = \"pf-iso\" }}\n{route}\n"
+        );
+        let path = dir.join(format!("fork{}.toml", route.len()));
+        std::fs::write(&path, text).unwrap();
+        let v = run_json("fork_route_run", &["--scenario", path.to_str().unwrap()]);
+        v["events"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|e| e.as_str())
+            .filter(|e| e.contains("changed lanes"))
+            .map(str::to_string)
+            .collect()
+    };
+    // Without a route (and routed to the exit) the car ends in the exit 22; routed straight on
+    // it stays on lanelet 21.
+    for route in ["", "route = [20, 22]"] {
+        let changes = lane_changes(route);
+        assert!(
+            changes.iter().any(|e| e.contains("to lane 22")),
+            "{route}: {changes:?}"
+        );
+    }
+    assert_eq!(lane_changes("route = [20, 21]"), Vec::<String>::new());
+}

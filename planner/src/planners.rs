@@ -216,7 +216,7 @@ impl PfPlanner {
         let p = [ego.x_m, ego.y_m];
         let target = self
             .road
-            .route_target_lane(self.road.lane_index_at(p), &self.route);
+            .route_target_lane(p, &self.route, self.params.target_lookahead_m);
         field.target_lane = target;
         field.target_s_m = self.road.s_m(target, p) + self.params.target_lookahead_m;
     }
