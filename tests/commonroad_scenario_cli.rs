@@ -18,7 +18,13 @@ const Y_MERGE: &str = concat!(
 fn run_json(name: &str, args: &[&str]) -> serde_json::Value {
     let dir = scratch(name);
     let json = dir.join("out.json");
-    let mut all = vec!["run", "--no-rrd", "--quiet", "--json", json.to_str().unwrap()];
+    let mut all = vec![
+        "run",
+        "--no-rrd",
+        "--quiet",
+        "--json",
+        json.to_str().unwrap(),
+    ];
     all.extend_from_slice(args);
     let out = merge_sim(&all);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -48,18 +54,30 @@ fn us101_runs_with_pf_iso_and_reports_its_goal() {
             v["goal_time_s"].is_number()
         );
     }
-    let v = run_json("us101_duration", &["--scenario", US101, "--duration", "2.5"]);
+    let v = run_json(
+        "us101_duration",
+        &["--scenario", US101, "--duration", "2.5"],
+    );
     assert_eq!(v["duration_s"], 2.5);
 }
 
 #[test]
 fn the_y_merge_ego_reaches_its_goal_lanelet() {
-    let v = run_json("y_merge", &["--scenario", Y_MERGE, "--recorded-traffic", "none"]);
+    let v = run_json(
+        "y_merge",
+        &["--scenario", Y_MERGE, "--recorded-traffic", "none"],
+    );
     assert_eq!(v["goal_reached"], true, "{v}");
     let t = v["goal_time_s"].as_f64().unwrap();
     // The ramp is ≈ 102 m long; the ego starts 5 m along it at 15 m/s.
     assert!(t > 5.0 && t < 8.0, "{t}");
-    let out = merge_sim(&["compare", "--scenario", Y_MERGE, "--recorded-traffic", "none"]);
+    let out = merge_sim(&[
+        "compare",
+        "--scenario",
+        Y_MERGE,
+        "--recorded-traffic",
+        "none",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(String::from_utf8_lossy(&out.stdout).contains("goal reached at s"));
     let out = merge_sim(&[
@@ -155,10 +173,17 @@ fn bad_commonroad_scenarios_exit_2_naming_file_line_and_element() {
         "cr_bounds",
         "b.xml",
         &bad,
-        &[format!("b.xml:{}: lanelet 10:", line_of(&bad, "<lanelet id=\"10\"")), "points".into()],
+        &[
+            format!("b.xml:{}: lanelet 10:", line_of(&bad, "<lanelet id=\"10\"")),
+            "points".into(),
+        ],
     );
     // An unsupported format version.
-    let bad = y.replacen("commonRoadVersion=\"2020a\"", "commonRoadVersion=\"2017a\"", 1);
+    let bad = y.replacen(
+        "commonRoadVersion=\"2020a\"",
+        "commonRoadVersion=\"2017a\"",
+        1,
+    );
     assert_refused("cr_version", "v.xml", &bad, &["2017a".into()]);
     // A goal no route reaches (lanelet 10, beside the ramp's start).
     let bad = y.replacen("<lanelet ref=\"12\"/>", "<lanelet ref=\"10\"/>", 1);
@@ -167,20 +192,29 @@ fn bad_commonroad_scenarios_exit_2_naming_file_line_and_element() {
         "g.xml",
         &bad,
         &[
-            format!("g.xml, line {}: planningProblem 201:", line_of(&bad, "<goalState>")),
+            format!(
+                "g.xml, line {}: planningProblem 201:",
+                line_of(&bad, "<goalState>")
+            ),
             "no route".into(),
         ],
     );
     // A planning problem whose initial state is on no lanelet.
     let pp = y.find("<planningProblem").unwrap();
     let (head, tail) = y.split_at(pp);
-    let bad = format!("{head}{}", tail.replacen("<x>5.0000</x>", "<x>-50.0000</x>", 1));
+    let bad = format!(
+        "{head}{}",
+        tail.replacen("<x>5.0000</x>", "<x>-50.0000</x>", 1)
+    );
     assert_refused(
         "cr_off_lanelet",
         "o.xml",
         &bad,
         &[
-            format!("o.xml, line {}: planningProblem 201:", line_of(&bad, "<planningProblem") + 1),
+            format!(
+                "o.xml, line {}: planningProblem 201:",
+                line_of(&bad, "<planningProblem") + 1
+            ),
             "on no lanelet".into(),
         ],
     );
@@ -254,7 +288,10 @@ fn too_many_lanelets_exit_2() {
         "cr_too_many",
         "many.xml",
         &text,
-        &[format!("{} lanelets", mergesim_commonroad::MAX_LANELETS + 1)],
+        &[format!(
+            "{} lanelets",
+            mergesim_commonroad::MAX_LANELETS + 1
+        )],
     );
 }
 

@@ -181,7 +181,10 @@ pub fn recorded_traffic(
             Shape::Circle { radius_m, .. } => (2.0 * radius_m, 2.0 * radius_m),
             Shape::Polygon { vertices_m } => {
                 let span = |k: usize| {
-                    let lo = vertices_m.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+                    let lo = vertices_m
+                        .iter()
+                        .map(|p| p[k])
+                        .fold(f64::INFINITY, f64::min);
                     let hi = vertices_m
                         .iter()
                         .map(|p| p[k])
@@ -194,7 +197,10 @@ pub fn recorded_traffic(
         let mut states: Vec<RecordedState> = Vec::with_capacity(o.trajectory.len() + 1);
         for s in std::iter::once(&o.initial_state).chain(&o.trajectory) {
             // A static obstacle's state may leave out its orientation and speed: 0.
-            let r = match (s.time_step, s.position.as_ref().and_then(Position::replay_m)) {
+            let r = match (
+                s.time_step,
+                s.position.as_ref().and_then(Position::replay_m),
+            ) {
                 (Some(t), Some(p)) => RecordedState {
                     time_s: t.midpoint() * cr.time_step_s - t0_s,
                     position_m: p,

@@ -101,7 +101,10 @@ pub(crate) fn road_source(
             ),
         ));
     }
-    if table.get("sim").is_some_and(|s| s.get("lane_road").is_some()) {
+    if table
+        .get("sim")
+        .is_some_and(|s| s.get("lane_road").is_some())
+    {
         return Err(invalid(
             origin,
             text,

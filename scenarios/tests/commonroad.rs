@@ -53,7 +53,10 @@ fn us101_ego_goal_and_traffic() {
     // Time steps 90–100 at 0.1 s.
     let t = goal.states[0].time_s.unwrap();
     assert!((t.start - 9.0).abs() < 1e-12 && (t.end - 10.0).abs() < 1e-12);
-    assert!(matches!(goal.states[0].position, Some(GoalPosition::Shapes(_))));
+    assert!(matches!(
+        goal.states[0].position,
+        Some(GoalPosition::Shapes(_))
+    ));
     // The run lasts until the goal's time interval ends.
     assert!((s.sim.duration_s - 10.0).abs() < 1e-12);
     // A route from the start lanelet to one the goal rectangle touches.
@@ -119,14 +122,11 @@ fn a_goal_no_route_reaches_is_refused_naming_file_line_and_problem() {
     assert_ne!(bad, text);
     let path = temp_file("unreachable.xml", &bad);
     let e = refusal(&path);
-    let line = bad
-        .lines()
-        .position(|l| l.contains("<goalState>"))
-        .unwrap()
-        + 1;
+    let line = bad.lines().position(|l| l.contains("<goalState>")).unwrap() + 1;
     assert!(
-        e.contains(&format!("unreachable.xml, line {line}: planningProblem 201:"))
-            && e.contains("no route")
+        e.contains(&format!(
+            "unreachable.xml, line {line}: planningProblem 201:"
+        )) && e.contains("no route")
             && e.contains("lanelet 11"),
         "{e}"
     );
@@ -163,10 +163,7 @@ fn reader_refusals_keep_file_line_and_element() {
     let path = temp_file("bad_ref.xml", &bad);
     let e = Scenario::load(path.to_str().unwrap()).unwrap_err();
     assert!(matches!(e, ScenarioError::CommonRoad(_)), "{e}");
-    assert!(
-        e.to_string().contains("bad_ref.xml:7: lanelet 10:"),
-        "{e}"
-    );
+    assert!(e.to_string().contains("bad_ref.xml:7: lanelet 10:"), "{e}");
 }
 
 fn toml_on_own_road(vehicles: &str, road_extra: &str) -> String {
@@ -181,8 +178,11 @@ const EGO: &str = "[[vehicles]]\nname = \"ego\"\npreset = \"bmw_320i\"\nlanelet 
 
 #[test]
 fn a_toml_scenario_on_a_commonroad_road_places_vehicles_by_lanelet() {
-    let s = Scenario::from_toml(&toml_on_own_road(EGO, "recorded_traffic = \"none\""), "t.toml")
-        .unwrap_or_else(|e| panic!("{e}"));
+    let s = Scenario::from_toml(
+        &toml_on_own_road(EGO, "recorded_traffic = \"none\""),
+        "t.toml",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(s.vehicles[0].lane.id(), LaneId(2));
     assert_eq!(s.vehicles[0].x_m, 10.0);
     assert_eq!(s.vehicles[0].y_offset_m, 0.5);
@@ -200,7 +200,9 @@ fn a_toml_scenario_on_a_commonroad_road_places_vehicles_by_lanelet() {
 fn a_vehicle_placed_off_its_lanelet_is_refused_at_its_d_m_line() {
     // d = 2.5 m: beyond the 3.5 m lanelet's half width (it would lie on the next lanelet).
     let text = toml_on_own_road(&EGO.replace("d_m = 0.5", "d_m = 2.5"), "");
-    let e = Scenario::from_toml(&text, "t.toml").unwrap_err().to_string();
+    let e = Scenario::from_toml(&text, "t.toml")
+        .unwrap_err()
+        .to_string();
     let line = text.lines().position(|l| l.starts_with("d_m")).unwrap() + 1;
     assert!(
         e.starts_with(&format!("t.toml, line {line}: "))
@@ -212,16 +214,27 @@ fn a_vehicle_placed_off_its_lanelet_is_refused_at_its_d_m_line() {
 
 #[test]
 fn commonroad_road_keys_are_checked() {
-    let e = Scenario::from_toml(&toml_on_own_road(EGO, "recorded_traffic = \"sometimes\""), "t.toml")
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("line 6") && e.contains("recorded_traffic"), "{e}");
+    let e = Scenario::from_toml(
+        &toml_on_own_road(EGO, "recorded_traffic = \"sometimes\""),
+        "t.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("line 6") && e.contains("recorded_traffic"),
+        "{e}"
+    );
     let e = Scenario::from_toml(&toml_on_own_road(EGO, "lane_width_m = 3.0"), "t.toml")
         .unwrap_err()
         .to_string();
-    assert!(e.contains("line 6") && e.contains("road.lane_width_m"), "{e}");
+    assert!(
+        e.contains("line 6") && e.contains("road.lane_width_m"),
+        "{e}"
+    );
     let missing = "name = \"t\"\n[sim.road]\ncommonroad = \"no/such/file.xml\"\n".to_string() + EGO;
-    let e = Scenario::from_toml(&missing, "t.toml").unwrap_err().to_string();
+    let e = Scenario::from_toml(&missing, "t.toml")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("no/such/file.xml"), "{e}");
 }
 

@@ -74,7 +74,9 @@ impl CommonRoadRoad {
         Self {
             file,
             recorded_traffic,
-            cached_spec: Some(Arc::new(mergesim_commonroad::road::lane_road_spec(scenario))),
+            cached_spec: Some(Arc::new(mergesim_commonroad::road::lane_road_spec(
+                scenario,
+            ))),
         }
     }
 

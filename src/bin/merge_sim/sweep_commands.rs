@@ -12,8 +12,7 @@ use crate::args::{MergeResultsArgs, SweepArgs};
 use crate::commands::{check_outputs, progress_bar, scenario_file};
 use crate::signals::Interrupt;
 use crate::{
-    Failure, input, interrupted, load_source, out, outln, run_failure, sweep_failure,
-    write_output,
+    Failure, input, interrupted, load_source, out, outln, run_failure, sweep_failure, write_output,
 };
 
 /// Longest sweep result file read back (`--resume`, `merge-results`): 4 GiB, beyond the rows
