@@ -161,7 +161,6 @@ pub(crate) fn apply(
     scenario: &mut Scenario,
     source: &RoadSource,
     base: Option<&Path>,
-    _origin: &str,
 ) -> Result<(), ScenarioError> {
     let written = Path::new(&source.file);
     let path = match base {

@@ -178,7 +178,7 @@ impl Scenario {
         };
         let mut scenario: Scenario = toml::from_str(text_read).map_err(parse_error)?;
         if let Some(source) = &source {
-            crate::commonroad_toml::apply(&mut scenario, source, base, origin)?;
+            crate::commonroad_toml::apply(&mut scenario, source, base)?;
         } else if scenario.sim.commonroad_road().is_some() {
             // `[sim.lane_road] commonroad = { file = … }` (e.g. a CommonRoad scenario written
             // out by `to_toml`): the same file reading.
