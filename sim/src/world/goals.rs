@@ -13,11 +13,16 @@ impl World {
     /// instant it is reached as an event.
     pub(super) fn check_goals(&mut self, t_s: f64, kins: &[Kinematics]) -> Result<(), SimError> {
         let mut reached = Vec::new();
+        let mut reached_at = Vec::new();
         for (i, (agent, k)) in self.agents.iter().zip(kins).enumerate() {
             let Some(goal) = &agent.spec.goal else {
                 continue;
             };
-            if self.goal_times[i].is_some() {
+            // Vehicles spawned after the world was built have no slot (and no goal).
+            let Some(slot) = self.goal_times.get(i) else {
+                continue;
+            };
+            if slot.is_some() {
                 continue;
             }
             let at = GoalCheck {
@@ -27,11 +32,16 @@ impl World {
                 speed_mps: k.speed_mps,
             };
             if goal.is_reached(&at, &self.lanes) {
-                self.goal_times[i] = Some(t_s);
+                reached_at.push(i);
                 reached.push(format!(
                     "t = {t_s:.2} s: {} reached its goal at x = {:.1} m, y = {:.1} m, {:.2} m/s",
                     agent.spec.name, k.x_m, k.y_m, k.speed_mps
                 ));
+            }
+        }
+        for i in reached_at {
+            if let Some(slot) = self.goal_times.get_mut(i) {
+                *slot = Some(t_s);
             }
         }
         for text in reached {
