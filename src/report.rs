@@ -91,6 +91,16 @@ fn comparison_rows(summaries: &[RunSummary]) -> Vec<(String, Vec<String>)> {
     });
     row("near miss", &|s| s.near_miss.to_string());
     row("fallbacks", &|s| s.planner_stats.fallbacks.to_string());
+    if summaries.iter().any(|s| s.goal_reached.is_some()) {
+        row(
+            "goal reached at s",
+            &|s| match (s.goal_reached, s.goal_time_s) {
+                (Some(true), Some(t)) => format!("{t:.2}"),
+                (Some(false), _) => "no".into(),
+                _ => "-".into(),
+            },
+        );
+    }
     let names: Vec<String> = summaries
         .first()
         .map(|s| s.vehicles.iter().map(|v| v.id.clone()).collect())

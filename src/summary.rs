@@ -53,6 +53,13 @@ pub struct RunSummary {
     pub vehicles: Vec<sim::metrics::VehicleMetricsSummary>,
     /// Planner counters and timing.
     pub planner_stats: PlannerStats,
+    /// Whether the ego (the first vehicle with a goal: a CommonRoad scenario's planning
+    /// problem) reached its goal (docs/commonroad.md); null when no vehicle has a goal.
+    #[serde(default)]
+    pub goal_reached: Option<bool>,
+    /// When it first met its goal (s); null if it did not or has none.
+    #[serde(default)]
+    pub goal_time_s: Option<f64>,
     /// Collision and safety events, in time order.
     pub events: Vec<String>,
     /// Wall time per phase of the tick (`merge_sim run --profile`); absent otherwise.
@@ -88,6 +95,8 @@ impl RunSummary {
             tet_s: outcome.safety.tet_s,
             vehicles: outcome.vehicles.clone(),
             planner_stats: outcome.planner_stats.clone(),
+            goal_reached: outcome.goals.first().map(|g| g.reached),
+            goal_time_s: outcome.goals.first().and_then(|g| g.time_s),
             events: outcome.events.clone(),
             profile: outcome.profile.clone(),
         }
@@ -133,6 +142,15 @@ impl RunSummary {
                 self.min_ttc_to_recorded_s
                     .map(|t| format!("{t:.2} s"))
                     .unwrap_or_else(|| "never closing".into()),
+            ));
+        }
+        if let Some(reached) = self.goal_reached {
+            out.push_str(&format!(
+                "goal reached {}\n",
+                match (reached, self.goal_time_s) {
+                    (true, Some(t)) => format!("yes, at t = {t:.2} s"),
+                    _ => "no".to_string(),
+                }
             ));
         }
         out.push_str(&format!(
@@ -212,6 +230,8 @@ mod tests {
             target_speed_mps: 10.0,
             driver: Driver::LaneKeeping,
             connected: false,
+            goal: None,
+            route: None,
         };
         let outcome = World::new(config, &[ego], &RunOptions::default(), Recorder::disabled())
             .and_then(|w| w.run(|_| {}))

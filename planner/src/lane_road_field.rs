@@ -286,6 +286,49 @@ impl LaneRoadGeometry {
             .unwrap_or(lane)
     }
 
+    /// The lane indices of a route given as lane ids (ids the road does not have are dropped).
+    pub fn route_indices(&self, route: &[LaneId]) -> Vec<usize> {
+        route
+            .iter()
+            .filter_map(|id| self.road.lanes().iter().position(|l| l.id() == *id))
+            .collect()
+    }
+
+    /// The target lane of a vehicle at `p_m` that follows `route` (lane indices in driving
+    /// order, e.g. to a goal), with Eq. 1's look-ahead `lookahead_m`:
+    /// - where a lane of the route holds the point (the latest such lane, so that at a fork the
+    ///   route's branch wins): the route's next lane if that is a neighbour across a divider
+    ///   (the lane change the route asks for), or a successor whose start lies within the
+    ///   look-ahead; else that lane;
+    /// - else a neighbour of the lane holding the point that is on the route;
+    /// - otherwise (or with an empty route) the lane-end rule, [`LaneRoadGeometry::target_lane`].
+    pub fn route_target_lane(&self, p_m: [f64; 2], route: &[usize], lookahead_m: f64) -> usize {
+        let lanes = self.road.lanes();
+        let neighbours = |a: usize, b: usize| self.side_of_neighbour(a, b).is_some();
+        let on_route = route.iter().enumerate().rev().find_map(|(k, &i)| {
+            let fp = self.frames[i].project(lanes[i].centreline(), p_m);
+            (lanes[i].frame_excess_m(fp) == 0.0).then_some((k, i, fp.s_m))
+        });
+        if let Some((k, lane, s_m)) = on_route {
+            return match route.get(k + 1) {
+                Some(&next) if neighbours(lane, next) => next,
+                Some(&next)
+                    if lanes[lane].successors().contains(&lanes[next].id())
+                        && lanes[lane].length_m() - s_m <= lookahead_m =>
+                {
+                    next
+                }
+                _ => lane,
+            };
+        }
+        let lane = self.lane_index_at(p_m);
+        route
+            .iter()
+            .copied()
+            .find(|&r| neighbours(lane, r))
+            .unwrap_or_else(|| self.target_lane(lane))
+    }
+
     /// The dividers that a vehicle in `state` (half-width `half_width_m`) sees as walls under
     /// the lane-end rule, with the sign that makes δ = sign·(d − d_div) positive on its side,
     /// and the lane it is settled in (to pass back on its next cycle as `settled_lane`).

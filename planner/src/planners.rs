@@ -37,8 +37,8 @@ use crate::speed_optimisation::{
     Aggregate, SpeedOptimiser, SpeedProblem, SpeedTerm, friction_speed_limits,
 };
 use crate::stop_and_go::{apply_caps, segment_time_s, stop_and_go_caps_mps};
-use crate::types::{FallbackReason, PathPoint, Plan, SharedLocalPath};
-use mergesim_types::lanes::LaneRoad;
+use crate::types::{FallbackReason, PathPoint, Plan, SharedLocalPath, VehicleState};
+use mergesim_types::lanes::{LaneId, LaneRoad};
 use std::sync::Arc;
 
 /// Which planner a vehicle runs.
@@ -146,6 +146,9 @@ pub struct PfPlanner {
     first_plan_s: Option<f64>,
     /// Whether the last cycle was a stop-and-go cycle (`stop_and_go` module).
     stopping: bool,
+    /// The lanes (indices) the vehicle drives along, e.g. to its goal
+    /// ([`PfPlanner::with_route`]); empty: the lane-end rule.
+    route: Vec<usize>,
 }
 
 fn non_finite(what: &str) -> PlannerError {
@@ -200,7 +203,29 @@ impl PfPlanner {
             stats: PlanStats::default(),
             first_plan_s: None,
             stopping: false,
+            route: Vec::new(),
         })
+    }
+
+    /// The planner following `route` (lane ids in driving order, e.g. the shortest route to a
+    /// goal): Eq. 1's target lane is the route's
+    /// ([`LaneRoadGeometry::route_target_lane`]) instead of the lane-end rule's.
+    pub fn with_route(mut self, route: &[LaneId]) -> Self {
+        self.route = self.road.route_indices(route);
+        self
+    }
+
+    /// Eq. 1's target on the route, if the planner has one.
+    fn follow_route(&self, field: &mut PotentialField<'_>, ego: &VehicleState) {
+        if self.route.is_empty() {
+            return;
+        }
+        let p = [ego.x_m, ego.y_m];
+        let target = self
+            .road
+            .route_target_lane(p, &self.route, self.params.target_lookahead_m);
+        field.target_lane = target;
+        field.target_s_m = self.road.s_m(target, p) + self.params.target_lookahead_m;
     }
 
     /// The planner kind.
@@ -249,6 +274,7 @@ impl PfPlanner {
             &req.ego_shape,
             req.neighbours,
         );
+        self.follow_route(&mut field, &req.ego);
         if self.params.lane_end_walls {
             field.road.walls = self
                 .road
@@ -400,6 +426,7 @@ impl PfPlanner {
             &req.ego_shape,
             req.neighbours,
         );
+        self.follow_route(&mut field, &req.ego);
         field.road.walls = walls;
         let step_m = params.step_length_m(req.ego.speed_mps);
         let time_per_step_s = if params.predict_obstacles_in_path {

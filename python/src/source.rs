@@ -20,6 +20,13 @@ pub fn load(source: &str, overrides_json: Option<&str>) -> Result<Scenario, Bind
         (source.to_string(), "<string>".to_string())
     } else if let Some(text) = builtin::toml_of(source) {
         (text.to_string(), format!("built-in {source}"))
+    } else if source.to_ascii_lowercase().ends_with(".xml") {
+        // A CommonRoad file: the scenario built from it, as TOML (its road source
+        // `[sim.lane_road.commonroad]` holds the file and the recorded traffic's mode, which
+        // overrides can set).
+        let scenario = Scenario::load(source).map_err(|e| BindingError::input(&e))?;
+        let text = scenario.to_toml().map_err(|e| BindingError::input(&e))?;
+        (text, source.to_string())
     } else {
         // The same errors as the CLI for a missing or unreadable file.
         Scenario::load(source).map_err(|e| BindingError::input(&e))?;

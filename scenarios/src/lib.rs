@@ -8,6 +8,8 @@
 #![warn(missing_docs)]
 
 pub mod builtin;
+pub mod commonroad;
+mod commonroad_toml;
 pub mod distribution;
 pub mod oriented_box;
 pub mod platoon;

@@ -94,6 +94,10 @@ pub enum ScenarioError {
         /// What the TOML reader said, with line and column.
         message: String,
     },
+    /// The CommonRoad file of the scenario cannot be read or does not make a road (names the
+    /// file, the line and the element).
+    #[error(transparent)]
+    CommonRoad(#[from] mergesim_commonroad::CommonRoadError),
     /// A value out of its allowed range, or values inconsistent with each other.
     #[error("{origin}{line}: {message}")]
     Invalid {
@@ -116,7 +120,8 @@ pub const ROAD_END_SPEED_ALLOWANCE: f64 = 0.1;
 pub const MAX_SCENARIO_BYTES: u64 = 16 << 20;
 
 impl Scenario {
-    /// Loads a built-in by name, or else a TOML file by path.
+    /// Loads a built-in by name, or else a file by path: a CommonRoad XML file (a name ending
+    /// in `.xml`, [`Scenario::from_commonroad`], recorded traffic replayed) or a scenario TOML.
     pub fn load(name_or_path: &str) -> Result<Self, ScenarioError> {
         if let Some(text) = builtin::toml_of(name_or_path) {
             return Self::from_toml(text, &format!("built-in {name_or_path}"));
@@ -128,24 +133,58 @@ impl Scenario {
                 builtins: builtin::names().join(", "),
             });
         }
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+        {
+            return Self::from_commonroad(path, sim::recorded_traffic::TrafficMode::default());
+        }
         let text = mergesim_types::files::read_regular_text(path, MAX_SCENARIO_BYTES).map_err(
             |source| ScenarioError::Io {
                 path: path.to_path_buf(),
                 source,
             },
         )?;
-        Self::from_toml(&text, &path.display().to_string())
+        Self::from_toml_in(&text, &path.display().to_string(), path.parent())
     }
 
-    /// Parses and validates a scenario from TOML text; `origin` names it in errors.
+    /// Parses and validates a scenario from TOML text; `origin` names it in errors. A
+    /// `[sim.road] commonroad = "…"` path is relative to the working directory.
     pub fn from_toml(text: &str, origin: &str) -> Result<Self, ScenarioError> {
+        Self::from_toml_in(text, origin, None)
+    }
+
+    /// [`Scenario::from_toml`] for a TOML file in the folder `base` (a `[sim.road]
+    /// commonroad = "…"` path is relative to it).
+    pub fn from_toml_in(
+        text: &str,
+        origin: &str,
+        base: Option<&Path>,
+    ) -> Result<Self, ScenarioError> {
         let parse_error = |e: toml::de::Error| ScenarioError::Parse {
             origin: origin.to_string(),
             message: e.to_string().trim_end().to_string(),
         };
-        let mut scenario: Scenario = toml::from_str(text).map_err(parse_error)?;
-        // The [sim.planner] values as written, to apply on top of the parameter set.
         let table: toml::Table = toml::from_str(text).map_err(parse_error)?;
+        // `[sim.road] commonroad = …` (commonroad_toml.rs): read without those keys.
+        let source = crate::commonroad_toml::road_source(&table, text, origin)?;
+        let stripped;
+        let text_read = match &source {
+            Some(s) => {
+                stripped = s.stripped_text.clone();
+                stripped.as_str()
+            }
+            None => text,
+        };
+        let mut scenario: Scenario = toml::from_str(text_read).map_err(parse_error)?;
+        if let Some(source) = &source {
+            crate::commonroad_toml::apply(&mut scenario, source, base)?;
+        } else if scenario.sim.commonroad_road().is_some() {
+            // `[sim.lane_road] commonroad = { file = … }` (e.g. a CommonRoad scenario written
+            // out by `to_toml`): the same file reading.
+            crate::commonroad_toml::read_lane_road_source(&mut scenario, base)?;
+        }
+        // The [sim.planner] values as written, to apply on top of the parameter set.
         scenario.planner_overrides = table
             .get("sim")
             .and_then(|sim| sim.get("planner"))
@@ -153,8 +192,12 @@ impl Scenario {
             .cloned()
             .unwrap_or_default();
         scenario.apply_parameter_set(origin, Some(text))?;
-        lane_road_checks::check_one_road(&table, &scenario, origin, text)?;
-        scenario.check(origin, Some(text))?;
+        if source.is_none() {
+            lane_road_checks::check_one_road(&table, &scenario, origin, text)?;
+        }
+        scenario
+            .check(origin, Some(text))
+            .map_err(|e| crate::commonroad_toml::aliased(e, &scenario, &table, text))?;
         Ok(scenario)
     }
 
@@ -170,7 +213,7 @@ impl Scenario {
     }
 
     /// `sim.planner` = the set's parameters with the overrides on top.
-    fn apply_parameter_set(
+    pub(crate) fn apply_parameter_set(
         &mut self,
         origin: &str,
         text: Option<&str>,

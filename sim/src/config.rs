@@ -4,9 +4,11 @@ use planner::{MergeRoad, PlannerParams, SpeedProfile};
 use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
 
+use mergesim_types::lanes::LaneId;
 use mergesim_types::{Bound, bounds};
 
 use crate::error::SimError;
+use crate::goal::Goal;
 use crate::idm::IdmParams;
 use crate::recorded_traffic::RecordedTraffic;
 use crate::road_config::{LaneRoadConfig, StartLane, build_lane_road};
@@ -126,6 +128,11 @@ impl SimConfig {
         build_lane_road(&self.road, self.lane_road.as_ref())
     }
 
+    /// The CommonRoad file the road comes from, if it does (`crate::road_config`).
+    pub fn commonroad_road(&self) -> Option<&crate::road_config::CommonRoadRoad> {
+        self.lane_road.as_ref()?.commonroad.as_ref()
+    }
+
     /// True if the road is the `[sim.road]` merge road, straight (no `lane_road`): vehicle
     /// positions are then world x (`x_m`) and offsets from the lane centre (`y_offset_m`).
     pub fn is_straight_merge_road(&self) -> bool {
@@ -233,15 +240,18 @@ pub struct VehicleSpec {
     pub name: String,
     /// Vehicle preset (`bmw_320i`, `ford_escort`, `vw_vanagon`).
     pub preset: String,
-    /// Starting lane: `"lower"` / `"upper"` (the merge road's lanes 2 and 1) or a lane id.
+    /// Starting lane: `"lower"` / `"upper"` (the merge road's lanes 2 and 1) or a lane id
+    /// (`lanelet = ID` on a CommonRoad road: a lanelet's id is its lane's).
+    #[serde(alias = "lanelet")]
     pub lane: StartLane,
     /// Initial longitudinal position of the centre of gravity (m): on the straight `[sim.road]`
     /// merge road its x; on a road of lanes (`[sim.lane_road]`) its arc length s along the start
-    /// lane's centreline, from the lane's first vertex.
+    /// lane's centreline, from the lane's first vertex (`s_m` is read as this).
+    #[serde(alias = "s_m")]
     pub x_m: f64,
     /// Lateral offset from the lane centre (m, positive to the left; on a road of lanes the
-    /// lane-frame offset d).
-    #[serde(default)]
+    /// lane-frame offset d; `d_m` is read as this).
+    #[serde(default, alias = "d_m")]
     pub y_offset_m: f64,
     /// Initial speed (m/s).
     pub speed_mps: f64,
@@ -252,6 +262,15 @@ pub struct VehicleSpec {
     /// Whether it sends and receives shared local paths.
     #[serde(default = "default_true")]
     pub connected: bool,
+    /// Its goal (`crate::goal`): checked every log period; `goal_reached` and `goal_time_s` in
+    /// the outcome. A CommonRoad scenario's ego gets its planning problem's goal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goal: Option<Goal>,
+    /// The lanes its planner drives along, in order (`crate::route`; a road of lanes only):
+    /// a potential-field planner targets the route's lane at or after its own. None: the
+    /// lane-end rule (its own lane, unless it ends).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub route: Option<Vec<LaneId>>,
 }
 
 fn default_true() -> bool {
@@ -336,14 +355,27 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
         if let Driver::Prescribed { speed_profile, .. } = &spec.driver {
             speed_profile.validate(&field("driver.prescribed"))?;
         }
+        // On a CommonRoad road the offset is bounded by the lanelet (below), not by ±1 m: a
+        // recorded initial state may lie anywhere across its lanelet.
+        let on_commonroad = config.commonroad_road().is_some();
+        let bounds_list: &[Bound] = if on_commonroad {
+            &VEHICLE_BOUNDS[1..]
+        } else {
+            VEHICLE_BOUNDS
+        };
+        let values = [
+            ("y_offset_m", spec.y_offset_m),
+            ("speed_mps", spec.speed_mps),
+            ("target_speed_mps", spec.target_speed_mps),
+        ];
         bounds::check_all(
             &format!("vehicles[{}]", spec.name),
-            VEHICLE_BOUNDS,
-            &[
-                ("y_offset_m", spec.y_offset_m),
-                ("speed_mps", spec.speed_mps),
-                ("target_speed_mps", spec.target_speed_mps),
-            ],
+            bounds_list,
+            if on_commonroad {
+                &values[1..]
+            } else {
+                &values[..]
+            },
         )?;
         if let Some(lanes) = lanes.as_ref() {
             let Some(lane) = lanes.lane(spec.lane.id()) else {
@@ -373,7 +405,33 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
                     ),
                 ));
             }
+            if on_commonroad {
+                let (right_m, left_m) = (lane.right_d_m(spec.x_m), lane.left_d_m(spec.x_m));
+                if !(spec.y_offset_m.is_finite()
+                    && right_m <= spec.y_offset_m
+                    && spec.y_offset_m <= left_m)
+                {
+                    return Err(SimError::invalid(
+                        field("y_offset_m"),
+                        spec.y_offset_m,
+                        format!(
+                            "the centre must lie on lanelet {}: at s = {:.3} m its offset d must \
+                             lie in [{right_m:.3}, {left_m:.3}] m",
+                            spec.lane, spec.x_m
+                        ),
+                    ));
+                }
+            }
+            if let Some(route) = &spec.route {
+                check_route(lanes, spec, route)?;
+            }
             continue;
+        }
+        if spec.route.is_some() {
+            return Err(SimError::InvalidField {
+                field: field("route"),
+                message: "a route needs a road of lanes ([sim.lane_road])".into(),
+            });
         }
         if spec.lane.merge_lane().is_none() {
             return Err(SimError::InvalidField {
@@ -396,6 +454,35 @@ pub fn validate_vehicles(config: &SimConfig, specs: &[VehicleSpec]) -> Result<()
                     config.road.start_x_m, config.road.end_x_m
                 ),
             ));
+        }
+    }
+    Ok(())
+}
+
+/// A route starts at the vehicle's lane and goes on, lane by lane, to a successor or a
+/// same-direction neighbour (`crate::route::next_lanes`).
+fn check_route(
+    lanes: &mergesim_types::lanes::LaneRoad,
+    spec: &VehicleSpec,
+    route: &[LaneId],
+) -> Result<(), SimError> {
+    let field = format!("vehicles[{}].route", spec.name);
+    if route.first() != Some(&spec.lane.id()) {
+        return Err(SimError::InvalidField {
+            field,
+            message: format!("a route must start at the vehicle's lane {}", spec.lane),
+        });
+    }
+    for pair in route.windows(2) {
+        if !crate::route::next_lanes(lanes, pair[0]).contains(&pair[1]) {
+            return Err(SimError::InvalidField {
+                field,
+                message: format!(
+                    "lane {} does not follow lane {} (neither a successor nor a same-direction \
+                     neighbour)",
+                    pair[1], pair[0]
+                ),
+            });
         }
     }
     Ok(())

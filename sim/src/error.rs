@@ -26,6 +26,10 @@ pub enum SimError {
     /// The road's lanes are inconsistent (the error names the lane and what is wrong).
     #[error("road: {0}")]
     Road(#[from] mergesim_types::lanes::LaneError),
+    /// The road's CommonRoad file cannot be read or is inconsistent (names the file, line and
+    /// element).
+    #[error(transparent)]
+    CommonRoad(#[from] mergesim_commonroad::CommonRoadError),
     /// The vehicle model refused its parameters or state.
     #[error(transparent)]
     Vehicle(#[from] vehicles::VehicleError),

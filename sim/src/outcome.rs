@@ -116,6 +116,9 @@ pub struct RunOutcome {
     pub time_series: Vec<TimeSeriesRow>,
     /// Event log lines (collisions, near misses, fallbacks), in time order.
     pub events: Vec<String>,
+    /// The goals of the vehicles that have one (`crate::goal`), in vehicle order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub goals: Vec<crate::goal::GoalOutcome>,
     /// Wall time per phase of the tick, if `RunOptions::profile` asked for it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub profile: Option<crate::profile::ProfileReport>,

@@ -75,6 +75,10 @@ impl std::fmt::Debug for BehaviourRegistry {
 fn pf_factory(kind: PlannerKind) -> BehaviourFactory {
     Arc::new(move |input: &FactoryInput<'_>| {
         PfPlanner::new(kind, input.config.planner.clone(), Arc::clone(input.lanes))
+            .map(|p| match &input.spec.route {
+                Some(route) => p.with_route(route),
+                None => p,
+            })
             .map(|p| Box::new(p) as Box<dyn Behaviour>)
             .map_err(|source| SimError::Planner {
                 vehicle: input.spec.name.clone(),

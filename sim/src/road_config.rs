@@ -10,11 +10,18 @@
 //!   acceleration lane entered from a ramp ([`on_ramp_spec`]; lanes 1, 2 main, 3 acceleration,
 //!   4 ramp);
 //! - `[sim.lane_road]` with `[[sim.lane_road.lanes]]`: lanes written out as polylines with widths
-//!   and links ([`LaneSpec`]), and optional `[sim.lane_road.tolerances]`.
+//!   and links ([`LaneSpec`]), and optional `[sim.lane_road.tolerances]`;
+//! - `[sim.lane_road]` with `commonroad = { file = "…", recorded_traffic = "replay" }`: the
+//!   lanelet network of a CommonRoad file ([`CommonRoadRoad`]; `mergesim_commonroad::road`),
+//!   lanelet ids as lane ids. A scenario TOML writes it as `[sim.road] commonroad = "…"`
+//!   (docs/commonroad.md); `--scenario FILE.xml` builds it.
 //!
-//! Exactly one of `curved_merge`, `on_ramp` and `lanes` is given in `[sim.lane_road]`.
+//! Exactly one of `curved_merge`, `on_ramp`, `lanes` and `commonroad` is given in
+//! `[sim.lane_road]`.
 
 use std::fmt;
+use std::path::PathBuf;
+use std::sync::Arc;
 
 use mergesim_types::lanes::{
     LaneId, LaneRoad, LaneRoadSpec, LaneSpec, LaneTolerances, OnRampParams, curved_merge_spec,
@@ -25,6 +32,7 @@ use serde::de::{self, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::error::SimError;
+use crate::recorded_traffic::TrafficMode;
 
 /// The merge road of `[sim.road]` bent on a circular arc.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -32,6 +40,56 @@ use crate::error::SimError;
 pub struct CurvedMergeConfig {
     /// Radius of the lane divider's arc (m); positive turns left, negative right.
     pub radius_m: f64,
+}
+
+/// A road read from a CommonRoad file's lanelet network.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CommonRoadRoad {
+    /// The CommonRoad XML file (the scenario loader makes it absolute; a path written in a
+    /// scenario TOML is relative to the TOML).
+    pub file: PathBuf,
+    /// How the file's obstacles move (`none`, `replay`, `reactive`); the loader fills
+    /// `SimConfig::recorded_traffic` with them in this mode.
+    #[serde(default)]
+    pub recorded_traffic: TrafficMode,
+    /// The lanes read from the file, kept by the loader so that checks do not read it again.
+    #[serde(skip)]
+    pub cached_spec: Option<Arc<LaneRoadSpec>>,
+}
+
+impl CommonRoadRoad {
+    /// A road read from `file`, with its lanes read now and kept.
+    pub fn read(file: PathBuf, recorded_traffic: TrafficMode) -> Result<Self, SimError> {
+        let scenario = mergesim_commonroad::read_file(&file)?;
+        Ok(Self::of(file, recorded_traffic, &scenario))
+    }
+
+    /// The road of a file already read.
+    pub fn of(
+        file: PathBuf,
+        recorded_traffic: TrafficMode,
+        scenario: &mergesim_commonroad::model::Scenario,
+    ) -> Self {
+        Self {
+            file,
+            recorded_traffic,
+            cached_spec: Some(Arc::new(mergesim_commonroad::road::lane_road_spec(
+                scenario,
+            ))),
+        }
+    }
+
+    /// Its lanes (the kept ones, else read from the file).
+    pub fn spec(&self) -> Result<LaneRoadSpec, SimError> {
+        match &self.cached_spec {
+            Some(spec) => Ok(LaneRoadSpec::clone(spec)),
+            None => {
+                let scenario = mergesim_commonroad::read_file(&self.file)?;
+                Ok(mergesim_commonroad::road::lane_road_spec(&scenario))
+            }
+        }
+    }
 }
 
 /// `[sim.lane_road]`: a road of lanes instead of the straight `[sim.road]` merge road (module
@@ -51,6 +109,9 @@ pub struct LaneRoadConfig {
     /// Cleaning and checking tolerances of written-out lanes.
     #[serde(default)]
     pub tolerances: LaneTolerances,
+    /// A CommonRoad file's lanelet network.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub commonroad: Option<CommonRoadRoad>,
 }
 
 /// Prefixes an invalid parameter's dotted name (`radius_m` → `lane_road.curved_merge.radius_m`).
@@ -71,14 +132,18 @@ impl LaneRoadConfig {
             self.curved_merge.is_some(),
             self.on_ramp.is_some(),
             !self.lanes.is_empty(),
+            self.commonroad.is_some(),
         ];
         if given.iter().filter(|g| **g).count() != 1 {
             return Err(SimError::InvalidField {
                 field: "lane_road".into(),
-                message: "give exactly one of lane_road.curved_merge, lane_road.on_ramp and \
-                          [[sim.lane_road.lanes]]"
+                message: "give exactly one of lane_road.curved_merge, lane_road.on_ramp, \
+                          [[sim.lane_road.lanes]] and lane_road.commonroad"
                     .into(),
             });
+        }
+        if let Some(c) = &self.commonroad {
+            return c.spec();
         }
         if let Some(c) = &self.curved_merge {
             return curved_merge_spec(road, c.radius_m).map_err(|e| {

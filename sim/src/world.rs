@@ -29,6 +29,7 @@ use crate::run_log::RunLog;
 use crate::safety::{BodyState, SafetyMonitor};
 use crate::v2v::V2vBus;
 
+mod goals;
 mod lanes;
 mod planning;
 mod recorded;
@@ -78,6 +79,10 @@ pub struct World {
     reported_edge_contacts: usize,
     profiler: Profiler,
     planning_pool: Option<std::sync::Arc<rayon::ThreadPool>>,
+    /// Per vehicle: when it reached its goal (`crate::goal`; `world/goals.rs`).
+    goal_times: Vec<Option<f64>>,
+    /// A vehicle left the map: the run has ended (`world/goals.rs`).
+    left_map: bool,
 }
 
 fn steps_for(period_s: f64, dt_s: f64) -> u64 {
@@ -178,6 +183,8 @@ impl World {
             planning_pool: None,
             reported_collisions: 0,
             reported_edge_contacts: 0,
+            goal_times: vec![None; specs.len()],
+            left_map: false,
         })
     }
 
@@ -234,11 +241,19 @@ impl World {
     ) -> Result<RunOutcome, SimError> {
         let total = self.total_steps();
         let report_every = (total / 100).max(1);
-        while self.step_index < total {
+        while self.step_index < total && !self.left_map {
             if interrupted() {
                 return Err(SimError::Interrupted { t_s: self.time_s() });
             }
-            self.step()?;
+            match self.step() {
+                Ok(()) => {}
+                // Leaving the map ends the run with an event, not an error.
+                Err(SimError::RoadEnd { vehicle, t_s, lane }) => {
+                    self.leave_map(&vehicle, t_s, lane)?;
+                    break;
+                }
+                Err(e) => return Err(e),
+            }
             if self.step_index.is_multiple_of(report_every) {
                 progress(self.step_index as f64 / total as f64);
             }
@@ -334,8 +349,9 @@ impl World {
                 self.report_new_collisions()?;
             }
             self.profiler.stop(Phase::Safety, started);
-            // 6. Observers.
+            // 6. Observers (goals first: their events are in this instant's log).
             if need_log {
+                self.check_goals(t_s, &kins)?;
                 self.log_instant(t_s, &kins, &bodies)?;
             }
         }
@@ -576,6 +592,7 @@ impl World {
         let vehicles = self.run_log.summaries();
         let v2v = self.bus.stats();
         let duration_s = self.time_s();
+        let goals = self.goal_outcomes();
         self.each_observer(|o| o.finish())?;
         Ok(RunOutcome {
             duration_s,
@@ -586,6 +603,7 @@ impl World {
             time_series: self.run_log.into_time_series(),
             profile: self.profiler.report(),
             events: self.events,
+            goals,
         })
     }
 }

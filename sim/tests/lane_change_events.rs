@@ -71,6 +71,8 @@ fn events_of(config: SimConfig, x_m: f64) -> (Vec<String>, u32) {
         target_speed_mps: 12.0,
         driver: Driver::Planner("weave".into()),
         connected: false,
+        goal: None,
+        route: None,
     }];
     let config = SimConfig {
         duration_s: 16.0,

@@ -88,6 +88,8 @@ fn seen_by_the_first(config: SimConfig) -> Seen {
             target_speed_mps: 15.0,
             driver: Driver::Planner("witness".into()),
             connected: true,
+            goal: None,
+            route: None,
         })
         .collect();
     let config = SimConfig {

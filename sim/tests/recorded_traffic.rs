@@ -45,6 +45,8 @@ fn spec(name: &str, x_m: f64, speed_mps: f64, driver: Driver) -> VehicleSpec {
         target_speed_mps: speed_mps,
         driver,
         connected: false,
+        goal: None,
+        route: None,
     }
 }
 

@@ -174,6 +174,11 @@ impl Scenario {
                 .max(v.target_speed_mps + b.target_speed_mps[1])
                 .max(prescribed_max_mps)
                 * (1.0 + super::ROAD_END_SPEED_ALLOWANCE);
+            // On a CommonRoad road a vehicle may drive off the map: that ends the run with an
+            // event (`sim::world`), as CommonRoad's maps end where their recordings do.
+            if self.sim.commonroad_road().is_some() {
+                continue;
+            }
             let needed_m = half_l + top_speed_mps * self.sim.duration_s;
             let ahead_m = drivable_ahead_m(&lanes, v.lane.id(), s_range[1]);
             if needed_m > ahead_m {

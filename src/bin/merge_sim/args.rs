@@ -88,9 +88,21 @@ pub(crate) enum CommonroadCommand {
 /// Which scenario, with which planner parameter set.
 #[derive(Args, Debug, Clone)]
 pub(crate) struct ScenarioArgs {
-    /// Built-in scenario name or path to a scenario TOML file.
+    /// Built-in scenario name, path to a scenario TOML file, or path to a CommonRoad XML file
+    /// (`.xml`, formats 2020a and 2018b: its lanelet network, its obstacles as recorded
+    /// traffic, the ego of its planning problem with its goal; docs/commonroad.md).
     #[arg(long, default_value = "urgent_merge", value_name = "NAME|PATH")]
     pub(crate) scenario: String,
+    /// How a CommonRoad road's recorded vehicles move: `none` (left out), `replay` (along their
+    /// recording, the default) or `reactive` (IDM once the recording would come too close to a
+    /// simulated vehicle ahead) [default: the scenario's, replay for an .xml file]. Only for a
+    /// scenario on a CommonRoad road.
+    #[arg(long, value_name = "MODE", value_parser = parse_traffic_mode)]
+    pub(crate) recorded_traffic: Option<sim::recorded_traffic::TrafficMode>,
+    /// Simulated time (s), instead of the scenario's duration_s (for an .xml file: until its
+    /// goal's time interval ends, else its last recorded state).
+    #[arg(long, value_name = "SECONDS")]
+    pub(crate) duration: Option<f64>,
     /// Planner parameter set: `paper` (the paper's literal reading) or `mergesim` (our
     /// improvements) [default: the scenario's `params`, else mergesim]. The scenario's
     /// [sim.planner] values apply on top of it.
@@ -290,6 +302,18 @@ pub(crate) enum ScenarioCommand {
 
 pub(crate) fn parse_planner(text: &str) -> Result<PlannerKind, String> {
     text.parse::<PlannerKind>().map_err(|e| e.to_string())
+}
+
+pub(crate) fn parse_traffic_mode(text: &str) -> Result<sim::recorded_traffic::TrafficMode, String> {
+    use sim::recorded_traffic::TrafficMode;
+    match text {
+        "none" => Ok(TrafficMode::None),
+        "replay" => Ok(TrafficMode::Replay),
+        "reactive" => Ok(TrafficMode::Reactive),
+        other => Err(format!(
+            "unknown mode {other:?} (valid: none, replay, reactive)"
+        )),
+    }
 }
 
 pub(crate) fn parse_params(text: &str) -> Result<ParameterSet, String> {

@@ -16,7 +16,7 @@ use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
 use crate::args::{CompareArgs, GridArgs, ManeuverArgs, ManeuverName, RunArgs, ScenarioCommand};
 use crate::signals::Interrupt;
 use crate::{
-    Failure, Simulation, input, interrupted, load_scenario, out, outln, run_failure, simulate,
+    Failure, Simulation, input, interrupted, load_source, out, outln, run_failure, simulate,
     write_output,
 };
 
@@ -65,7 +65,7 @@ const RECORDING_WARNING_BYTES: f64 = 500e6;
 
 pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failure> {
     use mergesim::output::file_name_part;
-    let scenario = load_scenario(&args.source.scenario, args.source.params)?;
+    let scenario = load_source(&args.source)?;
     let label = mergesim::sweep::planner_label(&scenario, args.planner);
     if !cfg!(feature = "rerun") && (args.rrd.is_some() || args.view) {
         return Err(crate::input(anyhow::anyhow!(
@@ -295,7 +295,7 @@ fn write_run_gif(
 }
 
 pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(), Failure> {
-    let scenario = load_scenario(&args.source.scenario, args.source.params)?;
+    let scenario = load_source(&args.source)?;
     check_outputs(
         &[
             (args.json.as_deref(), "--json"),
@@ -425,7 +425,7 @@ pub(crate) fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
 
 pub(crate) fn cmd_grid(args: &GridArgs, interrupt: &Interrupt) -> Result<(), Failure> {
     use mergesim::grid::{GridAxes, GridMetric, GridPlan, MAX_GRID_RUNS, job_count, run_grid};
-    let scenario = load_scenario(&args.source.scenario, args.source.params)?;
+    let scenario = load_source(&args.source)?;
     if !scenario.vehicles.iter().any(|v| v.name == args.vehicle) {
         return Err(input(anyhow!(
             "--vehicle {:?}: no such vehicle in scenario {} (vehicles: {})",

@@ -111,6 +111,19 @@ pub(crate) fn run_failure<E: Into<anyhow::Error>>(e: E) -> Failure {
     Failure::Run(e.into())
 }
 
+/// Loads the scenario of `--scenario`, with `--params`, `--recorded-traffic` and `--duration`
+/// applied.
+pub(crate) fn load_source(source: &args::ScenarioArgs) -> Result<Scenario, Failure> {
+    let mut scenario = load_scenario(&source.scenario, source.params)?;
+    if let Some(mode) = source.recorded_traffic {
+        scenario = scenario.with_recorded_traffic(mode).map_err(input)?;
+    }
+    if let Some(duration_s) = source.duration {
+        scenario = scenario.with_duration(duration_s).map_err(input)?;
+    }
+    Ok(scenario)
+}
+
 /// Loads a scenario and switches it to `params` if given.
 pub(crate) fn load_scenario(
     name_or_path: &str,

@@ -12,8 +12,7 @@ use crate::args::{MergeResultsArgs, SweepArgs};
 use crate::commands::{check_outputs, progress_bar, scenario_file};
 use crate::signals::Interrupt;
 use crate::{
-    Failure, input, interrupted, load_scenario, out, outln, run_failure, sweep_failure,
-    write_output,
+    Failure, input, interrupted, load_source, out, outln, run_failure, sweep_failure, write_output,
 };
 
 /// Longest sweep result file read back (`--resume`, `merge-results`): 4 GiB, beyond the rows
@@ -26,7 +25,7 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
         PairedSweepPlan, Shard, SweepIdentity, SweepOptions, resume::read_jsonl, run_paired_sweep,
         validate_paired,
     };
-    let scenario = load_scenario(&args.source.scenario, args.source.params)?;
+    let scenario = load_source(&args.source)?;
     // An existing JSONL passes (a regular file): --resume reads it back, else it is refused
     // below.
     check_outputs(
