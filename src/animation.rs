@@ -25,10 +25,10 @@ use std::path::{Path, PathBuf};
 use mergesim_types::lanes::LaneRoad;
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
-use sim::TimeSeriesRow;
 use sim::recording::vehicle_color;
 use sim::road_drawing::RoadDrawing;
 use sim::safety::CollisionEvent;
+use sim::{RecordedPose, TimeSeriesRow};
 use thiserror::Error;
 
 use crate::output::temporary_path;
@@ -214,7 +214,8 @@ fn frame_instants<'a>(all: &[&'a [TimeSeriesRow]], fps: f64) -> Vec<&'a [TimeSer
 
 /// Writes the animation of a run to `path` (through a temporary file, renamed when complete):
 /// the road `lanes`, the vehicles `vehicles`, their time series `rows` (as `RunOutcome`'s, in
-/// time order), the collisions `collisions`, following the vehicle named `follow`.
+/// time order), the recorded traffic `recorded` (`RunOutcome::recorded_track`, grey), the
+/// collisions `collisions`, following the vehicle named `follow`.
 /// `title` heads every frame. `progress` gets the fraction of frames written.
 #[allow(clippy::too_many_arguments)]
 pub fn write_gif(
@@ -222,6 +223,7 @@ pub fn write_gif(
     lanes: &LaneRoad,
     vehicles: &[GifVehicle],
     rows: &[TimeSeriesRow],
+    recorded: &[RecordedPose],
     collisions: &[CollisionEvent],
     follow: &str,
     title: &str,
@@ -258,6 +260,7 @@ pub fn write_gif(
         road: &drawing,
         lane_ids: params.lane_ids,
         vehicles,
+        recorded,
         collisions,
         follow,
         title,
@@ -330,6 +333,9 @@ pub fn write_gif(
 
 #[cfg(test)]
 mod curved_tests;
+
+#[cfg(test)]
+mod road_view_tests;
 
 #[cfg(test)]
 mod tests {
@@ -413,6 +419,18 @@ mod tests {
         geometry: &FrameGeometry,
         lane_ids: bool,
     ) -> Vec<u8> {
+        draw_with_recorded(lanes, instant, &[], view, geometry, lane_ids)
+    }
+
+    /// One frame of `lanes` with the recorded traffic `recorded`, drawn into memory.
+    pub(super) fn draw_with_recorded(
+        lanes: &LaneRoad,
+        instant: &[TimeSeriesRow],
+        recorded: &[RecordedPose],
+        view: GifView,
+        geometry: &FrameGeometry,
+        lane_ids: bool,
+    ) -> Vec<u8> {
         let road = RoadDrawing::new(lanes);
         let vehicles = vehicles();
         let size = geometry.size_px;
@@ -423,6 +441,7 @@ mod tests {
                 road: &road,
                 lane_ids,
                 vehicles: &vehicles,
+                recorded,
                 collisions: &[],
                 follow: "ego",
                 title: "test",

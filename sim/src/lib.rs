@@ -42,7 +42,7 @@ pub use mergesim_types::{
     VehicleState,
 };
 pub use observer::{PlanView, TickObserver, VehicleView};
-pub use outcome::{PlannerStats, RunOutcome, TimeSeriesRow};
+pub use outcome::{PlannerStats, RecordedPose, RunOutcome, TimeSeriesRow};
 pub use registry::{BehaviourFactory, BehaviourRegistry, FactoryInput};
 pub use road_config::{CommonRoadRoad, LaneRoadConfig, StartLane};
 pub use world::{RunOptions, World};

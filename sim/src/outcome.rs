@@ -98,6 +98,25 @@ pub struct PlannerStats {
     pub p99_plan_us: f64,
 }
 
+/// A recorded vehicle's box at one log instant.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordedPose {
+    /// Simulated time (s).
+    pub t_s: f64,
+    /// Its name.
+    pub vehicle: String,
+    /// Centre (m).
+    pub x_m: f64,
+    /// Centre (m).
+    pub y_m: f64,
+    /// Heading (rad).
+    pub yaw_rad: f64,
+    /// Length (m).
+    pub length_m: f64,
+    /// Width (m).
+    pub width_m: f64,
+}
+
 /// The result of a run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunOutcome {
@@ -114,6 +133,10 @@ pub struct RunOutcome {
     pub v2v: V2vStats,
     /// Time series at the log period (empty unless requested).
     pub time_series: Vec<TimeSeriesRow>,
+    /// Where the recorded traffic was at each log instant, kept with the time series (empty
+    /// unless requested, or without recorded traffic): what the GIF draws of it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub recorded_track: Vec<RecordedPose>,
     /// Event log lines (collisions, near misses, fallbacks), in time order.
     pub events: Vec<String>,
     /// The goals of the vehicles that have one (`crate::goal`), in vehicle order.

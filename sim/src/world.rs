@@ -62,6 +62,8 @@ pub struct World {
     bus: V2vBus,
     safety: SafetyMonitor,
     run_log: RunLog,
+    /// The recorded traffic's boxes at each log instant, if the time series is kept.
+    recorded_track: Option<Vec<crate::outcome::RecordedPose>>,
     recording: RecordingObserver,
     observers: Vec<Box<dyn TickObserver>>,
     events: Vec<String>,
@@ -170,6 +172,7 @@ impl World {
             bus,
             safety,
             run_log: RunLog::new(metrics, options.keep_time_series),
+            recorded_track: options.keep_time_series.then(Vec::new),
             recording,
             observers: Vec::new(),
             events: Vec::new(),
@@ -557,6 +560,19 @@ impl World {
                 .map(|b| names.get(b.id as usize).cloned().unwrap_or_default())
                 .collect();
             self.recording.log_recorded(recorded, &labels)?;
+            if let Some(track) = self.recorded_track.as_mut() {
+                track.extend(recorded.iter().zip(&labels).map(|(b, name)| {
+                    crate::outcome::RecordedPose {
+                        t_s,
+                        vehicle: name.clone(),
+                        x_m: b.x_m,
+                        y_m: b.y_m,
+                        yaw_rad: b.yaw_rad,
+                        length_m: b.length_m,
+                        width_m: b.width_m,
+                    }
+                }));
+            }
         }
         self.profiler.stop(Phase::Recording, started);
         Ok(())
@@ -601,6 +617,7 @@ impl World {
             planner_stats,
             v2v,
             time_series: self.run_log.into_time_series(),
+            recorded_track: self.recorded_track.unwrap_or_default(),
             profile: self.profiler.report(),
             events: self.events,
             goals,

@@ -1,16 +1,19 @@
 //! One frame of the animation: where road coordinates fall in the picture (the follow window or
 //! the whole road) and the drawing of the road, the vehicles and the header.
 
-use mergesim_types::lanes::LaneRoad;
+use mergesim_types::lanes::{LaneRoad, Side};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use sim::TimeSeriesRow;
 use sim::recording::vehicle_color;
 use sim::road_drawing::{RoadDrawing, road_middle_offset_m, road_width_m};
 use sim::safety::CollisionEvent;
+use sim::{RecordedPose, TimeSeriesRow};
 
 use super::{GifParams, GifVehicle, GifView};
 use crate::plots::font;
+
+/// Colour of recorded traffic (the recording's grey).
+pub(super) const RECORDED_GREY: [u8; 3] = [150, 150, 150];
 
 /// Height of the header line (pixels).
 pub(super) const HEADER_PX: u32 = 22;
@@ -31,8 +34,9 @@ const MIN_FOOTPRINT_PX: (f64, f64) = (8.0, 5.0);
 const ROAD_VIEW_MAX_STRETCHED_HEIGHT: f64 = 1.0;
 
 /// How road coordinates map to a frame's pixels: a point p is turned into the view's axes,
-/// (u, v) = R(−rotation) (p − origin), then u goes to the right and v up. The road view has no
-/// rotation and its origin at (0, 0) (u, v = X, Y); the follow view's origin is the followed
+/// (u, v) = R(−rotation) (p − origin), then u goes to the right and v up. The road view has its
+/// origin at (0, 0) and no rotation (u, v = X, Y) unless its lanes run along another direction
+/// ([`road_view_rotation_rad`]); the follow view's origin is the followed
 /// vehicle's station on the middle of the road, turned so that its lane runs to the right,
 /// along a curve too.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -92,13 +96,46 @@ impl FrameGeometry {
     }
 
     /// The road view: the whole road, and every position in `rows`, across the picture's
-    /// width; the vehicles' names in a band above and below the road.
+    /// width; the vehicles' names in a band above and below the road. A road whose lanes run
+    /// along another direction than +X (a recorded map) is turned so that they run to the right
+    /// ([`road_view_rotation_rad`]).
     pub fn whole_road(lanes: &LaneRoad, params: &GifParams, rows: &[TimeSeriesRow]) -> Self {
-        let [blo, bhi] = RoadDrawing::new(lanes).bounds_m;
+        let rotation_rad = road_view_rotation_rad(lanes);
+        let turned = Self {
+            origin_m: [0.0, 0.0],
+            rotation_rad,
+            x0_m: 0.0,
+            y_top_m: 0.0,
+            px_per_m_x: 1.0,
+            px_per_m_y: 1.0,
+            top_px: 0,
+            size_px: (1, 1),
+        };
+        let (blo, bhi) = if rotation_rad == 0.0 {
+            let [blo, bhi] = RoadDrawing::new(lanes).bounds_m;
+            (blo, bhi)
+        } else {
+            let mut lo = [f64::INFINITY; 2];
+            let mut hi = [f64::NEG_INFINITY; 2];
+            for lane in lanes.lanes() {
+                for side in [Side::Left, Side::Right] {
+                    for p in lane.bound_polyline(side) {
+                        let (u, v) = turned.to_view_m(p[0], p[1]);
+                        lo = [lo[0].min(u), lo[1].min(v)];
+                        hi = [hi[0].max(u), hi[1].max(v)];
+                    }
+                }
+            }
+            (lo, hi)
+        };
         let (mut lo, mut hi) = (blo[0], bhi[0]);
-        for r in rows.iter().filter(|r| r.x_m.is_finite()) {
-            lo = lo.min(r.x_m - 5.0);
-            hi = hi.max(r.x_m + 5.0);
+        for r in rows
+            .iter()
+            .filter(|r| r.x_m.is_finite() && r.y_m.is_finite())
+        {
+            let (u, _) = turned.to_view_m(r.x_m, r.y_m);
+            lo = lo.min(u - 5.0);
+            hi = hi.max(u + 5.0);
         }
         let span = (hi - lo).max(1.0);
         let pad = 0.01 * span;
@@ -114,7 +151,7 @@ impl FrameGeometry {
         let road_px = (height_m * px_per_m_y).ceil().clamp(16.0, 4000.0);
         Self {
             origin_m: [0.0, 0.0],
-            rotation_rad: 0.0,
+            rotation_rad,
             x0_m: lo - pad,
             y_top_m: bhi[1] + params.margin_m,
             px_per_m_x,
@@ -147,6 +184,32 @@ impl FrameGeometry {
     }
 }
 
+/// Roads within this angle of the X axis (rad, 0.06°) are drawn unturned in the road view.
+const ROAD_VIEW_UNTURNED_RAD: f64 = 1e-3;
+
+/// The road view's rotation: the direction from the longest lane's first centreline vertex to
+/// its last; 0 for a road within [`ROAD_VIEW_UNTURNED_RAD`] of the X axis (the built-in merge
+/// roads keep their picture).
+pub fn road_view_rotation_rad(lanes: &LaneRoad) -> f64 {
+    let Some(longest) = lanes
+        .lanes()
+        .iter()
+        .max_by(|a, b| a.length_m().total_cmp(&b.length_m()))
+    else {
+        return 0.0;
+    };
+    let c = longest.centreline().vertices_m();
+    let (Some(first), Some(last)) = (c.first(), c.last()) else {
+        return 0.0;
+    };
+    let chord_rad = (last[1] - first[1]).atan2(last[0] - first[0]);
+    if chord_rad.abs() < ROAD_VIEW_UNTURNED_RAD || !chord_rad.is_finite() {
+        0.0
+    } else {
+        chord_rad
+    }
+}
+
 /// The corners of a footprint centred at (x, y) with heading `yaw`.
 pub(super) fn footprint(x: f64, y: f64, yaw: f64, length: f64, width: f64) -> [(f64, f64); 4] {
     let (s, c) = yaw.sin_cos();
@@ -161,6 +224,8 @@ pub(super) struct FrameScene<'a> {
     /// Write each lane's id on the road.
     pub(super) lane_ids: bool,
     pub(super) vehicles: &'a [GifVehicle],
+    /// The recorded traffic's boxes (`RunOutcome::recorded_track`, in time order).
+    pub(super) recorded: &'a [RecordedPose],
     pub(super) collisions: &'a [CollisionEvent],
     pub(super) follow: &'a str,
     pub(super) title: &'a str,
@@ -178,6 +243,7 @@ pub(super) fn draw_frame(
         road,
         lane_ids,
         vehicles,
+        recorded,
         collisions,
         follow,
         title,
@@ -227,6 +293,25 @@ pub(super) fn draw_frame(
             ))
             .map_err(|x| e(&x))?;
         }
+    }
+    // Recorded traffic at this instant: grey boxes, unlabelled.
+    let first = recorded.partition_point(|p| p.t_s < t_s);
+    for pose in recorded[first..].iter().take_while(|p| p.t_s == t_s) {
+        if ![pose.x_m, pose.y_m, pose.yaw_rad]
+            .iter()
+            .all(|c| c.is_finite())
+        {
+            continue;
+        }
+        let length_m = pose.length_m.max(MIN_FOOTPRINT_PX.0 / geometry.px_per_m_x);
+        let width_m = pose.width_m.max(MIN_FOOTPRINT_PX.1 / geometry.px_per_m_y);
+        let corners = footprint(pose.x_m, pose.y_m, pose.yaw_rad, length_m, width_m)
+            .map(|(x, y)| to_px(x, y));
+        root.draw(&Polygon::new(
+            corners.to_vec(),
+            RGBColor(RECORDED_GREY[0], RECORDED_GREY[1], RECORDED_GREY[2]).filled(),
+        ))
+        .map_err(|x| e(&x))?;
     }
     // Vehicles: footprints first, names on top.
     let mut labels = Vec::new();

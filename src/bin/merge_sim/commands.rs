@@ -273,6 +273,7 @@ fn write_run_gif(
         &lanes,
         &vehicles,
         &finished.outcome.time_series,
+        &finished.outcome.recorded_track,
         &finished.outcome.safety.collisions,
         follow,
         &title,
