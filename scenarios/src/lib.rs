@@ -11,6 +11,7 @@ pub mod builtin;
 pub mod commonroad;
 mod commonroad_toml;
 pub mod distribution;
+mod opendrive_source;
 pub mod oriented_box;
 pub mod platoon;
 pub mod randomisation;

@@ -184,6 +184,8 @@ impl Scenario {
             // out by `to_toml`): the same file reading.
             crate::commonroad_toml::read_lane_road_source(&mut scenario, base)?;
         }
+        // `[sim.lane_road] opendrive = { file = … }`: read once, relative to the TOML.
+        crate::opendrive_source::read_opendrive_source(&mut scenario, base, origin, Some(text))?;
         // The [sim.planner] values as written, to apply on top of the parameter set.
         scenario.planner_overrides = table
             .get("sim")

@@ -30,6 +30,9 @@ pub enum SimError {
     /// element).
     #[error(transparent)]
     CommonRoad(#[from] mergesim_commonroad::CommonRoadError),
+    /// The road's OpenDRIVE file cannot be read or gives no consistent road (names the file).
+    #[error(transparent)]
+    OpenDrive(#[from] mergesim_opendrive::OpenDriveError),
     /// The vehicle model refused its parameters or state.
     #[error(transparent)]
     Vehicle(#[from] vehicles::VehicleError),

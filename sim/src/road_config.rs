@@ -16,7 +16,11 @@
 //!   lanelet ids as lane ids. A scenario TOML writes it as `[sim.road] commonroad = "…"`
 //!   (docs/commonroad.md); `--scenario FILE.xml` builds it.
 //!
-//! Exactly one of `curved_merge`, `on_ramp`, `lanes` and `commonroad` is given in
+//! - `[sim.lane_road]` with `opendrive = { file = "…" }`: the drivable lanes of an OpenDRIVE
+//!   file ([`OpenDriveRoadSource`]; `mergesim_opendrive`), lane ids as `merge_sim opendrive
+//!   dump` lists them; the file is relative to the TOML (docs/opendrive.md).
+//!
+//! Exactly one of `curved_merge`, `on_ramp`, `lanes`, `commonroad` and `opendrive` is given in
 //! `[sim.lane_road]`.
 
 use std::fmt;
@@ -92,8 +96,41 @@ impl CommonRoadRoad {
     }
 }
 
+/// A road read from an OpenDRIVE file's drivable lanes (`mergesim_opendrive`; lane ids as
+/// `merge_sim opendrive dump` lists them).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OpenDriveRoadSource {
+    /// The OpenDRIVE file (the scenario loader makes it absolute; a path written in a scenario
+    /// TOML is relative to the TOML).
+    pub file: PathBuf,
+    /// The lanes read from the file, kept by the loader so that checks do not read it again.
+    #[serde(skip)]
+    pub cached_spec: Option<Arc<LaneRoadSpec>>,
+}
+
+impl OpenDriveRoadSource {
+    /// A road read from `file` now, its lanes kept.
+    pub fn read(file: PathBuf) -> Result<Self, SimError> {
+        let road = mergesim_opendrive::read_file(&file)?;
+        road.lane_road()?;
+        Ok(Self {
+            file,
+            cached_spec: Some(Arc::new(road.spec)),
+        })
+    }
+
+    /// Its lanes (the kept ones, else read from the file).
+    pub fn spec(&self) -> Result<LaneRoadSpec, SimError> {
+        match &self.cached_spec {
+            Some(spec) => Ok(LaneRoadSpec::clone(spec)),
+            None => Ok(mergesim_opendrive::read_file(&self.file)?.spec),
+        }
+    }
+}
+
 /// `[sim.lane_road]`: a road of lanes instead of the straight `[sim.road]` merge road (module
-/// doc). Exactly one of `curved_merge`, `on_ramp`, `lanes`.
+/// doc). Exactly one of `curved_merge`, `on_ramp`, `lanes`, `commonroad`, `opendrive`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LaneRoadConfig {
@@ -112,6 +149,9 @@ pub struct LaneRoadConfig {
     /// A CommonRoad file's lanelet network.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub commonroad: Option<CommonRoadRoad>,
+    /// An OpenDRIVE file's drivable lanes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub opendrive: Option<OpenDriveRoadSource>,
 }
 
 /// Prefixes an invalid parameter's dotted name (`radius_m` → `lane_road.curved_merge.radius_m`).
@@ -133,17 +173,21 @@ impl LaneRoadConfig {
             self.on_ramp.is_some(),
             !self.lanes.is_empty(),
             self.commonroad.is_some(),
+            self.opendrive.is_some(),
         ];
         if given.iter().filter(|g| **g).count() != 1 {
             return Err(SimError::InvalidField {
                 field: "lane_road".into(),
                 message: "give exactly one of lane_road.curved_merge, lane_road.on_ramp, \
-                          [[sim.lane_road.lanes]] and lane_road.commonroad"
+                          [[sim.lane_road.lanes]], lane_road.commonroad and lane_road.opendrive"
                     .into(),
             });
         }
         if let Some(c) = &self.commonroad {
             return c.spec();
+        }
+        if let Some(o) = &self.opendrive {
+            return o.spec();
         }
         if let Some(c) = &self.curved_merge {
             return curved_merge_spec(road, c.radius_m).map_err(|e| {
