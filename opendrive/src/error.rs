@@ -9,12 +9,12 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum OpenDriveError {
     /// The file could not be read.
-    #[error("{path}: cannot read the OpenDRIVE file: {source}")]
+    #[error("{path}: cannot read the OpenDRIVE file: {error}")]
     Io {
         /// The file.
         path: PathBuf,
-        /// Why.
-        source: std::io::Error,
+        /// Why (in the message, so not also a source).
+        error: std::io::Error,
     },
     /// The importer refused the document (not well-formed XML, or no usable lanes); its message
     /// gives the position where it has one.
@@ -24,6 +24,17 @@ pub enum OpenDriveError {
         path: PathBuf,
         /// What the importer said.
         message: String,
+    },
+    /// The importer met a fault in the file (a value it could not read, a geometry, lane or
+    /// link it dropped): the road would differ from the file.
+    #[error("{path}: {message}{}", if *more > 0 { format!(" (and {more} more faults)") } else { String::new() })]
+    Fault {
+        /// The file.
+        path: PathBuf,
+        /// The first fault, as the importer words it (it names the road and lane).
+        message: String,
+        /// How many more faults.
+        more: usize,
     },
     /// The document has no drivable lane.
     #[error("{path}: no drivable lane (driving, entry, exit, ramps, …) in the file")]
@@ -62,13 +73,13 @@ pub enum OpenDriveError {
     },
     /// The lanes do not make a consistent road (the message names the mergesim lane; the
     /// OpenDRIVE road and lane are named beside it).
-    #[error("{path}: {origin}: {source}")]
+    #[error("{path}: {origin}: {error}")]
     Road {
         /// The file.
         path: PathBuf,
         /// The OpenDRIVE road and lane the refused lane came from, if known.
         origin: String,
-        /// What the lane road refused.
-        source: LaneError,
+        /// What the lane road refused (in the message, so not also a source).
+        error: LaneError,
     },
 }

@@ -67,7 +67,7 @@ impl OpenDriveRoad {
             OpenDriveError::Road {
                 path: self.path.clone(),
                 origin,
-                source: e,
+                error: e,
             }
         })
     }
@@ -78,13 +78,12 @@ impl OpenDriveRoad {
 /// # Errors
 /// The file cannot be read, the importer refuses it, or it has no (or too many) drivable lanes.
 pub fn read_file(path: &Path) -> Result<OpenDriveRoad, OpenDriveError> {
-    let text =
-        mergesim_types::files::read_regular_text(path, MAX_FILE_BYTES).map_err(|source| {
-            OpenDriveError::Io {
-                path: path.to_path_buf(),
-                source,
-            }
-        })?;
+    let text = mergesim_types::files::read_regular_text(path, MAX_FILE_BYTES).map_err(|error| {
+        OpenDriveError::Io {
+            path: path.to_path_buf(),
+            error,
+        }
+    })?;
     read_str(&text, path)
 }
 
@@ -98,6 +97,22 @@ pub fn read_str(text: &str, path: &Path) -> Result<OpenDriveRoad, OpenDriveError
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;
+    // Faults the importer worked around that change the lanes (a dropped road, geometry,
+    // lane section, lane or lane link, an unreadable value): the road would silently differ
+    // from the file, so it is refused ([`changes_the_lanes`]).
+    let faults: Vec<&xodr::Warning> = provenance
+        .warnings
+        .iter()
+        .filter(|w| changes_the_lanes(w))
+        .collect();
+    if let Some(fault) = faults.first() {
+        let more = faults.len() - 1;
+        return Err(OpenDriveError::Fault {
+            path: path.to_path_buf(),
+            message: fault.to_string(),
+            more,
+        });
+    }
     let origin_of: BTreeMap<usize, &xodr::LaneProvenance> =
         provenance.lanes.iter().map(|p| (p.lane.0, p)).collect();
     let drivable: Vec<&xodr::Lane> = net
@@ -189,6 +204,27 @@ pub fn read_str(text: &str, path: &Path) -> Result<OpenDriveRoad, OpenDriveError
         },
         lanes: origins,
     })
+}
+
+/// Whether an importer warning means the lanes differ from what the file says: a road,
+/// geometry, lane section, lane, lane link, junction connection or neighbour dropped, a lane id
+/// unreadable or repeated, a record value unreadable. Other warnings (features ignored, records
+/// sorted, speed limits, objects, road marks, elevation) leave the lanes as written.
+fn changes_the_lanes(w: &xodr::Warning) -> bool {
+    use xodr::Warning as W;
+    matches!(
+        w,
+        W::RoadSkipped { .. }
+            | W::GeometryDropped { .. }
+            | W::LaneSectionDropped { .. }
+            | W::LaneDropped { .. }
+            | W::LaneIdUnreadable { .. }
+            | W::LaneIdRepeated { .. }
+            | W::LaneLinkDropped { .. }
+            | W::ConnectionDropped { .. }
+            | W::NeighborDropped { .. }
+            | W::RecordValueUnreadable { .. }
+    )
 }
 
 /// The lane's centreline in travel direction and its half widths per vertex.

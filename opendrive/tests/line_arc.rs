@@ -134,3 +134,21 @@ fn a_map_far_from_the_origin_is_refused_for_the_importers_precision() {
     let near = text.replace(r#"y="0.0" hdg"#, r#"y="90000.0" hdg"#);
     assert!(mergesim_opendrive::read_str(&near, Path::new("near.xodr")).is_ok());
 }
+
+#[test]
+fn a_geometry_the_importer_drops_is_refused_not_skipped() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/line_arc_merge.xodr");
+    let text = std::fs::read_to_string(&path).unwrap();
+    for bad in ["NaN", "abc"] {
+        let broken = text.replacen(
+            r#"length="100.0"><line/>"#,
+            &format!(r#"length="{bad}"><line/>"#),
+            1,
+        );
+        assert_ne!(broken, text);
+        let e = mergesim_opendrive::read_str(&broken, Path::new("bad.xodr")).unwrap_err();
+        let msg = e.to_string();
+        assert!(msg.starts_with("bad.xodr: road \"1\""), "{bad}: {msg}");
+        assert!(msg.contains("dropped"), "{bad}: {msg}");
+    }
+}

@@ -308,10 +308,12 @@ pub fn ego_of(
                 .next()
                 .and_then(|l| l.parse().ok())
                 .unwrap_or(pp.line);
-            return Err(invalid(
-                path,
-                line,
-                element,
+            let message = if targets.is_empty() {
+                format!(
+                    "the goal ({source}) lies on no lanelet: no route from lanelet {lane}, where \
+                     the ego starts, can reach it"
+                )
+            } else {
                 format!(
                     "no route along the lanelets (successors and same-direction neighbours) \
                      leads from lanelet {lane}, where the ego starts, to its goal ({source}, on \
@@ -321,8 +323,9 @@ pub fn ego_of(
                         .map(|l| l.to_string())
                         .collect::<Vec<_>>()
                         .join(", ")
-                ),
-            ));
+                )
+            };
+            return Err(invalid(path, line, element, message));
         }
         best
     } else {
