@@ -54,6 +54,24 @@ pub fn planner_params_with_overrides(
         .map_err(|e: toml::de::Error| e.to_string())
 }
 
+/// A CommonRoad file that a scenario TOML names and that cannot be read, refused naming the
+/// TOML, the line of the key that names it and the field, then the file's own error.
+fn file_error_in_toml(e: ScenarioError, origin: &str, text: &str, key: &[&str]) -> ScenarioError {
+    match e {
+        ScenarioError::CommonRoad(e) => {
+            let path: Vec<String> = key.iter().map(|k| k.to_string()).collect();
+            let field = path.join(".");
+            ScenarioError::Invalid {
+                origin: origin.to_string(),
+                line: Line(line_of(text, &path)),
+                message: format!("{field}: {e}"),
+                field: Some(field),
+            }
+        }
+        other => other,
+    }
+}
+
 /// A line of a scenario text, shown as `, line N` after the file name (nothing if unknown).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Line(pub Option<usize>);
@@ -178,11 +196,14 @@ impl Scenario {
         };
         let mut scenario: Scenario = toml::from_str(text_read).map_err(parse_error)?;
         if let Some(source) = &source {
-            crate::commonroad_toml::apply(&mut scenario, source, base)?;
+            crate::commonroad_toml::apply(&mut scenario, source, base)
+                .map_err(|e| file_error_in_toml(e, origin, text, &["sim", "road", "commonroad"]))?;
         } else if scenario.sim.commonroad_road().is_some() {
             // `[sim.lane_road] commonroad = { file = … }` (e.g. a CommonRoad scenario written
             // out by `to_toml`): the same file reading.
-            crate::commonroad_toml::read_lane_road_source(&mut scenario, base)?;
+            crate::commonroad_toml::read_lane_road_source(&mut scenario, base).map_err(|e| {
+                file_error_in_toml(e, origin, text, &["sim", "lane_road", "commonroad"])
+            })?;
         }
         // `[sim.lane_road] opendrive = { file = … }`: read once, relative to the TOML.
         crate::opendrive_source::read_opendrive_source(&mut scenario, base, origin, Some(text))?;

@@ -248,3 +248,25 @@ fn a_commonroad_scenario_written_as_toml_reads_back_the_same() {
     assert_eq!(back.sim.recorded_traffic, s.sim.recorded_traffic);
     assert_eq!(back.sim.lane_road, s.sim.lane_road);
 }
+
+#[test]
+fn a_toml_whose_commonroad_file_cannot_be_read_is_named_with_its_line() {
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("commonroad/urgent_merge_acceleration_lane.toml");
+    let text = std::fs::read_to_string(shipped).unwrap();
+    // Copied elsewhere, its relative path to the XML no longer leads anywhere.
+    let path = temp_file("moved.toml", &text);
+    let e = refusal(&path);
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("commonroad ="))
+        .unwrap()
+        + 1;
+    assert!(
+        e.starts_with(&format!(
+            "{}, line {line}: sim.road.commonroad: ",
+            path.display()
+        )) && e.contains("acceleration_lane.xml"),
+        "{e}"
+    );
+}
