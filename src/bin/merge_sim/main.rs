@@ -121,6 +121,22 @@ pub(crate) fn load_source(source: &args::ScenarioArgs) -> Result<Scenario, Failu
     if let Some(duration_s) = source.duration {
         scenario = scenario.with_duration(duration_s).map_err(input)?;
     }
+    let traffic = &scenario.sim.recorded_traffic;
+    if !traffic.is_empty() {
+        let recording_end_s = traffic
+            .vehicles
+            .iter()
+            .filter(|v| v.states.len() > 1)
+            .filter_map(|v| v.states.last().map(|s| s.time_s))
+            .fold(f64::NEG_INFINITY, f64::max);
+        if recording_end_s.is_finite() && scenario.sim.duration_s > recording_end_s + 1e-9 {
+            eprintln!(
+                "warning: the run lasts {:.2} s, past the recording's end at {recording_end_s:.2} s: \
+                 each recorded vehicle leaves the run when its recording ends",
+                scenario.sim.duration_s
+            );
+        }
+    }
     Ok(scenario)
 }
 
