@@ -218,6 +218,25 @@ pub(super) fn footprint(x: f64, y: f64, yaw: f64, length: f64, width: f64) -> [(
         .map(|(dx, dy)| (x + c * dx - s * dy, y + s * dx + c * dy))
 }
 
+/// The pixel corners of a footprint at `pose_m` = (x, y, yaw), at least [`MIN_FOOTPRINT_PX`]
+/// in size; `None` for a non-finite pose.
+fn footprint_px(
+    geometry: &FrameGeometry,
+    pose_m: [f64; 3],
+    length_m: f64,
+    width_m: f64,
+) -> Option<[(i32, i32); 4]> {
+    if !pose_m.iter().all(|c| c.is_finite()) {
+        return None;
+    }
+    let length_m = length_m.max(MIN_FOOTPRINT_PX.0 / geometry.px_per_m_x);
+    let width_m = width_m.max(MIN_FOOTPRINT_PX.1 / geometry.px_per_m_y);
+    Some(
+        footprint(pose_m[0], pose_m[1], pose_m[2], length_m, width_m)
+            .map(|(x, y)| geometry.to_px(x, y)),
+    )
+}
+
 /// What one frame shows besides its instant.
 pub(super) struct FrameScene<'a> {
     pub(super) road: &'a RoadDrawing,
@@ -297,16 +316,10 @@ pub(super) fn draw_frame(
     // Recorded traffic at this instant: grey boxes, unlabelled.
     let first = recorded.partition_point(|p| p.t_s < t_s);
     for pose in recorded[first..].iter().take_while(|p| p.t_s == t_s) {
-        if ![pose.x_m, pose.y_m, pose.yaw_rad]
-            .iter()
-            .all(|c| c.is_finite())
-        {
+        let pose_m = [pose.x_m, pose.y_m, pose.yaw_rad];
+        let Some(corners) = footprint_px(geometry, pose_m, pose.length_m, pose.width_m) else {
             continue;
-        }
-        let length_m = pose.length_m.max(MIN_FOOTPRINT_PX.0 / geometry.px_per_m_x);
-        let width_m = pose.width_m.max(MIN_FOOTPRINT_PX.1 / geometry.px_per_m_y);
-        let corners = footprint(pose.x_m, pose.y_m, pose.yaw_rad, length_m, width_m)
-            .map(|(x, y)| to_px(x, y));
+        };
         root.draw(&Polygon::new(
             corners.to_vec(),
             RGBColor(RECORDED_GREY[0], RECORDED_GREY[1], RECORDED_GREY[2]).filled(),
@@ -319,16 +332,10 @@ pub(super) fn draw_frame(
         let Some(v) = vehicles.iter().find(|v| v.name == row.vehicle) else {
             continue;
         };
-        if ![row.x_m, row.y_m, row.yaw_rad]
-            .iter()
-            .all(|c| c.is_finite())
-        {
+        let pose_m = [row.x_m, row.y_m, row.yaw_rad];
+        let Some(corners) = footprint_px(geometry, pose_m, v.length_m, v.width_m) else {
             continue;
-        }
-        let length_m = v.length_m.max(MIN_FOOTPRINT_PX.0 / geometry.px_per_m_x);
-        let width_m = v.width_m.max(MIN_FOOTPRINT_PX.1 / geometry.px_per_m_y);
-        let corners =
-            footprint(row.x_m, row.y_m, row.yaw_rad, length_m, width_m).map(|(x, y)| to_px(x, y));
+        };
         // Outside the window: not drawn (its label would be pinned to the picture's edge).
         if corners.iter().all(|&(x, _)| x < 0) || corners.iter().all(|&(x, _)| x >= w as i32) {
             continue;
