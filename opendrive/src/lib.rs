@@ -5,7 +5,7 @@
 //! and bakes every lane into a centreline polyline with per-vertex widths and a lane graph.
 //! This crate turns its **drivable** lanes (`driving`, `entry`, `exit`, `onRamp`, `offRamp`,
 //! `connectingRamp`, `slipLane`, `bidirectional`, `bus`, `taxi`, `hov`, `shared`) into a
-//! [`LaneRoadSpec`]:
+//! [`LaneRoadSpec`](mergesim_types::lanes::LaneRoadSpec):
 //!
 //! - **Ids**: the i-th drivable lane in the importer's order gets mergesim lane id i + 1;
 //!   [`OpenDriveRoad::lanes`] maps each id back to its OpenDRIVE road id, lane-section index

@@ -36,7 +36,7 @@ const ROAD_VIEW_MAX_STRETCHED_HEIGHT: f64 = 1.0;
 /// How road coordinates map to a frame's pixels: a point p is turned into the view's axes,
 /// (u, v) = R(−rotation) (p − origin), then u goes to the right and v up. The road view has its
 /// origin at (0, 0) and no rotation (u, v = X, Y) unless its lanes run along another direction
-/// ([`road_view_rotation_rad`]); the follow view's origin is the followed
+/// (`road_view_rotation_rad`); the follow view's origin is the followed
 /// vehicle's station on the middle of the road, turned so that its lane runs to the right,
 /// along a curve too.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,7 +98,7 @@ impl FrameGeometry {
     /// The road view: the whole road, and every position in `rows`, across the picture's
     /// width; the vehicles' names in a band above and below the road. A road whose lanes run
     /// along another direction than +X (a recorded map) is turned so that they run to the right
-    /// ([`road_view_rotation_rad`]).
+    /// (`road_view_rotation_rad`).
     pub fn whole_road(lanes: &LaneRoad, params: &GifParams, rows: &[TimeSeriesRow]) -> Self {
         let rotation_rad = road_view_rotation_rad(lanes);
         let turned = Self {
