@@ -31,6 +31,7 @@ use crate::v2v::V2vBus;
 
 mod goals;
 mod lanes;
+mod outputs;
 mod planning;
 mod recorded;
 
@@ -488,149 +489,6 @@ impl World {
         }
         Ok(())
     }
-
-    fn log_instant(
-        &mut self,
-        t_s: f64,
-        kins: &[Kinematics],
-        bodies: &[BodyState],
-    ) -> Result<(), SimError> {
-        // Lane changes first (events), then the observers.
-        self.log_lane_changes(t_s, kins)?;
-        let samples: Vec<MetricsSample> = kins
-            .iter()
-            .map(|k| MetricsSample {
-                t_s,
-                x_m: k.x_m,
-                y_m: k.y_m,
-                yaw_rad: k.yaw_rad,
-                yaw_rate_radps: k.yaw_rate_radps,
-                sideslip_rad: k.sideslip_rad,
-                speed_mps: k.speed_mps,
-                accel_long_mps2: k.accel_long_mps2,
-                accel_lat_mps2: k.accel_lat_mps2,
-            })
-            .collect();
-        let received: Vec<Vec<SharedLocalPath>> = self
-            .agents
-            .iter()
-            .map(|a| {
-                let wanted = self.recording.wants_received_paths_of(a.id)
-                    || self
-                        .observers
-                        .iter()
-                        .any(|o| o.wants_received_paths_of(a.id));
-                if wanted && a.spec.connected {
-                    self.bus.fresh_paths(a.id, t_s)
-                } else {
-                    Vec::new()
-                }
-            })
-            .collect();
-        let views: Vec<VehicleView<'_>> = self
-            .agents
-            .iter()
-            .enumerate()
-            .map(|(i, a)| VehicleView {
-                id: a.id,
-                name: &a.spec.name,
-                kinematics: &kins[i],
-                body: &bodies[i],
-                sample: &samples[i],
-                path: &a.path,
-                planned_speed_mps: planned_speed_at(&a.path, t_s).unwrap_or(kins[i].speed_mps),
-                connected: a.spec.connected,
-                received: &received[i],
-            })
-            .collect();
-        let started = self.profiler.start();
-        self.run_log.on_log(t_s, &views)?;
-        for observer in &mut self.observers {
-            observer.on_log(t_s, &views)?;
-        }
-        self.profiler.stop(Phase::Metrics, started);
-        let started = self.profiler.start();
-        self.recording.on_log(t_s, &views)?;
-        if !self.recorded.is_empty() {
-            // Recorded traffic: drawn, not in the time series (`recorded` module doc).
-            let names = self.names();
-            let recorded = &bodies[self.agents.len()..];
-            let labels: Vec<String> = recorded
-                .iter()
-                .map(|b| names.get(b.id as usize).cloned().unwrap_or_default())
-                .collect();
-            self.recording.log_recorded(recorded, &labels)?;
-            if let Some(track) = self.recorded_track.as_mut() {
-                track.extend(recorded.iter().zip(&labels).map(|(b, name)| {
-                    crate::outcome::RecordedPose {
-                        t_s,
-                        vehicle: name.clone(),
-                        x_m: b.x_m,
-                        y_m: b.y_m,
-                        yaw_rad: b.yaw_rad,
-                        length_m: b.length_m,
-                        width_m: b.width_m,
-                    }
-                }));
-            }
-        }
-        self.profiler.stop(Phase::Recording, started);
-        Ok(())
-    }
-
-    fn finish(mut self) -> Result<RunOutcome, SimError> {
-        let safety = self.safety.summary();
-        if safety.near_miss {
-            let text = format!(
-                "near miss: min gap {} m, min TTC {}",
-                safety
-                    .min_gap_m
-                    .map(|g| format!("{g:.2}"))
-                    .unwrap_or_else(|| "-".into()),
-                safety
-                    .min_ttc_s
-                    .map(|t| format!("{t:.2} s"))
-                    .unwrap_or_else(|| "none".into())
-            );
-            self.event(text, EventLevel::Warn)?;
-        }
-        let mut times = self.plan_times_us.clone();
-        times.sort_by(f64::total_cmp);
-        let planner_stats = PlannerStats {
-            plans: times.len() as u64,
-            fallbacks: self.fallbacks,
-            degraded_plans: self.degraded_plans,
-            optimiser_solves: self.optimiser_solves,
-            optimiser_iteration_cap_cycles: self.optimiser_iteration_cap_cycles,
-            p50_plan_us: percentile(&times, 0.50),
-            p99_plan_us: percentile(&times, 0.99),
-        };
-        let vehicles = self.run_log.summaries();
-        let v2v = self.bus.stats();
-        let duration_s = self.time_s();
-        let goals = self.goal_outcomes();
-        self.each_observer(|o| o.finish())?;
-        Ok(RunOutcome {
-            duration_s,
-            safety,
-            vehicles,
-            planner_stats,
-            v2v,
-            time_series: self.run_log.into_time_series(),
-            recorded_track: self.recorded_track.unwrap_or_default(),
-            profile: self.profiler.report(),
-            events: self.events,
-            goals,
-        })
-    }
-}
-
-fn percentile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return 0.0;
-    }
-    let rank = (q * (sorted.len() - 1) as f64).round() as usize;
-    sorted[rank.min(sorted.len() - 1)]
 }
 
 fn check_finite(t_s: f64, name: &str, k: &Kinematics) -> Result<(), SimError> {
@@ -650,24 +508,4 @@ fn check_finite(t_s: f64, name: &str, k: &Kinematics) -> Result<(), SimError> {
             what: format!("vehicle {name}: state {values:?}"),
         })
     }
-}
-
-/// The speed the path asks for at time `t_s` (linear in time between its points).
-fn planned_speed_at(path: &[PathPoint], t_s: f64) -> Option<f64> {
-    let first = path.first()?;
-    if t_s <= first.t_s {
-        return Some(first.speed_mps);
-    }
-    for pair in path.windows(2) {
-        if t_s <= pair[1].t_s {
-            let span = pair[1].t_s - pair[0].t_s;
-            let w = if span > 0.0 {
-                (t_s - pair[0].t_s) / span
-            } else {
-                1.0
-            };
-            return Some(pair[0].speed_mps + w * (pair[1].speed_mps - pair[0].speed_mps));
-        }
-    }
-    path.last().map(|p| p.speed_mps)
 }
