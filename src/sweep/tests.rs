@@ -42,6 +42,7 @@ fn fake(seed: u64) -> Result<RunMetrics, RunFailure> {
         fallbacks: seed % 2,
         degraded_plans: 0,
         plans: 10,
+        commonroad: None,
     })
 }
 

@@ -133,8 +133,9 @@ pub(crate) struct RunArgs {
     /// The instance index of --sweep-seed (a sweep row's `instance`).
     #[arg(long, value_name = "I", requires = "sweep_seed")]
     pub(crate) instance: Option<u64>,
-    /// Where to write the Rerun recording [default: <scenario>_<planner>.rrd; none in a build
-    /// without the cargo feature `rerun`].
+    /// Where to write the Rerun recording [default: <scenario>_<planner>.rrd, on a CommonRoad
+    /// road <scenario>_<planner>[_<mode>][_<D>s].rrd (the --recorded-traffic mode unless
+    /// `replay`, the --duration if given); none in a build without the cargo feature `rerun`].
     #[arg(long, value_name = "PATH", conflicts_with = "no_rrd")]
     pub(crate) rrd: Option<PathBuf>,
     /// Do not write a Rerun recording.
@@ -432,9 +433,11 @@ pub(crate) struct GridArgs {
     /// Sweep seed of the drawn instances (decimal or 0x hex).
     #[arg(long, default_value = "0", value_name = "K", value_parser = parse_seed)]
     pub(crate) seed: u64,
-    /// Vehicle whose figures the table and the figure compare.
-    #[arg(long, default_value = "obstacle", value_name = "NAME")]
-    pub(crate) vehicle: String,
+    /// Vehicle whose figures the table and the figure compare [default: the scenario's
+    /// vehicle named `obstacle` (the built-in merges' merging car), else its first vehicle not
+    /// named `ego`, else its first vehicle (the ego of a CommonRoad file)].
+    #[arg(long, value_name = "NAME")]
+    pub(crate) vehicle: Option<String>,
     /// Write every run (one line per run and vehicle) here.
     #[arg(long, value_name = "PATH")]
     pub(crate) csv: Option<PathBuf>,
