@@ -359,7 +359,10 @@ pub(crate) struct SweepArgs {
     /// Append one JSON line per run here as it finishes (the sweep's identity with its
     /// planners, instance, planner, seed, status, the drawn values under `drawn`, the figures,
     /// each vehicle's figures under `vehicles`, wall time), flushed at once, so an interrupted
-    /// sweep loses no finished run. An existing file is refused unless --resume is given.
+    /// sweep loses no finished run. On a CommonRoad road a completed run's figures add
+    /// `recorded_traffic` (the mode), `collisions_caused_by_replay`, `min_gap_to_recorded_m`,
+    /// `min_ttc_to_recorded_s`, `goal_reached`, `goal_time_s` (also in --json and --parquet).
+    /// An existing file is refused unless --resume is given.
     #[arg(long, value_name = "PATH")]
     pub(crate) jsonl: Option<PathBuf>,
     /// Complete an interrupted sweep: read the --jsonl file of the same sweep (same scenario,
