@@ -114,7 +114,8 @@ pub fn run_instance(
         options.seed,
         wall_time_s,
         &outcome,
-    );
+    )
+    .with_recorded_traffic(&scenario.sim);
     Ok(Finished { summary, outcome })
 }
 

@@ -60,16 +60,21 @@ pub fn comparison_markdown(caption: &RunCaption, summaries: &[RunSummary]) -> St
     out
 }
 
-/// The JSON of `merge_sim compare --json`: the caption's fields, then the runs' summaries.
+/// The JSON of `merge_sim compare --json`: the caption's fields (`recorded_traffic` on a
+/// CommonRoad road only), then the runs' summaries.
 pub fn comparison_json(caption: &RunCaption, summaries: &[RunSummary]) -> serde_json::Value {
-    serde_json::json!({
+    let mut json = serde_json::json!({
         "scenario": caption.scenario,
         "params": caption.params,
         "seed": caption.seed.map(|s| s.to_string()),
         "commit": caption.commit,
         "caption": caption.line(),
         "runs": summaries,
-    })
+    });
+    if let (Some(mode), Some(fields)) = (&caption.recorded_traffic, json.as_object_mut()) {
+        fields.insert("recorded_traffic".into(), mode.clone().into());
+    }
+    json
 }
 
 /// The rows of the comparison: (label, one value per run).
@@ -90,6 +95,21 @@ fn comparison_rows(summaries: &[RunSummary]) -> Vec<(String, Vec<String>)> {
             .unwrap_or_else(|| "-".into())
     });
     row("near miss", &|s| s.near_miss.to_string());
+    if summaries.iter().any(|s| s.recorded_traffic.is_some()) {
+        row("caused by replay", &|s| {
+            s.collisions_caused_by_replay.to_string()
+        });
+        row("min gap to recorded m", &|s| {
+            s.min_gap_to_recorded_m
+                .map(|g| format!("{g:.2}"))
+                .unwrap_or_else(|| "-".into())
+        });
+        row("min TTC to recorded s", &|s| {
+            s.min_ttc_to_recorded_s
+                .map(|t| format!("{t:.2}"))
+                .unwrap_or_else(|| "-".into())
+        });
+    }
     row("fallbacks", &|s| s.planner_stats.fallbacks.to_string());
     if summaries.iter().any(|s| s.goal_reached.is_some()) {
         row(
@@ -286,6 +306,7 @@ mod tests {
             params: "custom (paper + [sim.planner] substeps)".into(),
             seed: Some(18_446_744_073_709_551_615),
             commit: "0123456789ab".into(),
+            recorded_traffic: None,
         }
     }
 

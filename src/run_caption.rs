@@ -18,6 +18,10 @@ pub struct RunCaption {
     pub seed: Option<u64>,
     /// The simulator's commit, shortened ([`crate::build_info::short_commit`]).
     pub commit: String,
+    /// How the recorded traffic of a CommonRoad road moves (`none`, `replay`, `reactive`);
+    /// `None` on any other road (and then not in the line).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub recorded_traffic: Option<String>,
 }
 
 impl RunCaption {
@@ -33,10 +37,15 @@ impl RunCaption {
             params: params_label(scenario.params.name(), &keys),
             seed,
             commit: crate::build_info::short_commit(),
+            recorded_traffic: scenario
+                .sim
+                .commonroad_road()
+                .map(|road| road.recorded_traffic.to_string()),
         }
     }
 
-    /// One line: `scenario S · parameters P · nominal|seed N · mergesim COMMIT`.
+    /// One line: `scenario S · parameters P · nominal|seed N · mergesim COMMIT`, with
+    /// `· recorded traffic MODE` after the instance on a CommonRoad road.
     pub fn line(&self) -> String {
         let instance = self
             .seed
@@ -46,8 +55,13 @@ impl RunCaption {
 
     /// The line with `instance` in place of the seed (e.g. the instances of a grid).
     pub fn line_with(&self, instance: &str) -> String {
+        let traffic = self
+            .recorded_traffic
+            .as_ref()
+            .map(|mode| format!(" · recorded traffic {mode}"))
+            .unwrap_or_default();
         format!(
-            "scenario {} · parameters {} · {instance} · mergesim {}",
+            "scenario {} · parameters {} · {instance}{traffic} · mergesim {}",
             self.scenario, self.params, self.commit
         )
     }
@@ -82,10 +96,20 @@ mod tests {
             params: "paper".into(),
             seed: Some(7),
             commit: "0123456789ab".into(),
+            recorded_traffic: None,
         };
         assert_eq!(
             caption.line(),
             "scenario urgent_merge · parameters paper · seed 7 · mergesim 0123456789ab"
+        );
+        let on_commonroad = RunCaption {
+            recorded_traffic: Some("reactive".into()),
+            ..caption
+        };
+        assert_eq!(
+            on_commonroad.line(),
+            "scenario urgent_merge · parameters paper · seed 7 · recorded traffic reactive · \
+             mergesim 0123456789ab"
         );
     }
 
@@ -95,6 +119,7 @@ mod tests {
         let caption = RunCaption::of_scenario(&scenario, None);
         assert_eq!(caption.params, scenario.params.name());
         assert_eq!(caption.commit, crate::build_info::short_commit());
+        assert_eq!(caption.recorded_traffic, None);
         assert!(caption.line().contains("· nominal ·"), "{}", caption.line());
         assert_eq!(
             params_label("mergesim", &["substeps", "path_time_gap_s"]),

@@ -25,6 +25,11 @@ pub struct RunSummary {
     pub duration_s: f64,
     /// Wall-clock time of the simulation (s); the only field that differs between reruns.
     pub wall_time_s: f64,
+    /// How the recorded traffic of a CommonRoad road moved (`none`, `replay`, `reactive`);
+    /// absent for a scenario on no CommonRoad road. Filled by the caller
+    /// ([`RunSummary::with_recorded_traffic`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recorded_traffic: Option<String>,
     /// Number of collision events (vehicle–vehicle and vehicle–road edge) of the simulated
     /// vehicles, without those caused by the replay of recorded traffic.
     pub collisions: usize,
@@ -83,6 +88,7 @@ impl RunSummary {
             planner: planner.to_string(),
             seed,
             drawn: None,
+            recorded_traffic: None,
             duration_s: outcome.duration_s,
             wall_time_s,
             collisions: outcome.safety.own_collisions() + outcome.safety.edge_contacts.len(),
@@ -111,6 +117,15 @@ impl RunSummary {
         self
     }
 
+    /// The summary with `recorded_traffic` named from `sim`: the mode of its CommonRoad road's
+    /// recorded traffic, nothing on any other road.
+    pub fn with_recorded_traffic(mut self, sim: &sim::SimConfig) -> Self {
+        self.recorded_traffic = sim
+            .commonroad_road()
+            .map(|road| road.recorded_traffic.to_string());
+        self
+    }
+
     /// A fixed-width table for the terminal.
     pub fn table(&self) -> String {
         let mut out = String::new();
@@ -132,9 +147,17 @@ impl RunSummary {
             if self.near_miss { "yes" } else { "no" },
             self.tet_s
         ));
-        if self.collisions_caused_by_replay > 0 || self.min_gap_to_recorded_m.is_some() {
+        if self.recorded_traffic.is_some()
+            || self.collisions_caused_by_replay > 0
+            || self.min_gap_to_recorded_m.is_some()
+        {
+            let mode = self
+                .recorded_traffic
+                .as_ref()
+                .map(|m| format!(" ({m})"))
+                .unwrap_or_default();
             out.push_str(&format!(
-                "recorded traffic: collisions caused by replay {}  min gap {}  min TTC {}\n",
+                "recorded traffic{mode}: collisions caused by replay {}  min gap {}  min TTC {}\n",
                 self.collisions_caused_by_replay,
                 self.min_gap_to_recorded_m
                     .map(|g| format!("{g:.2} m"))

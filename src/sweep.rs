@@ -48,7 +48,7 @@ pub use engine::{RunRequest, run_paired_sweep_with, validate_paired};
 pub use figures::{RunFigures, VehicleRow, describe_instance, drawn_unit, drawn_values};
 pub use merge::{merge_reports, merge_shards, merged_jsonl};
 pub use paired::{BetterWhen, PairedDifference, PairedSweepSummary, SweepReport};
-pub use rows::{JsonlRecord, RunMetrics, RunRow, RunStatus};
+pub use rows::{CommonRoadFigures, JsonlRecord, RunMetrics, RunRow, RunStatus};
 pub use shard::{Shard, ShardError};
 pub use summary::{SweepIdentity, SweepSummary, jsonl_line};
 

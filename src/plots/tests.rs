@@ -8,6 +8,7 @@ fn caption() -> RunCaption {
         params: "mergesim".into(),
         seed: None,
         commit: "0123456789ab".into(),
+        recorded_traffic: None,
     }
 }
 

@@ -81,6 +81,7 @@ fn fake(request: &RunRequest) -> Result<RunFigures, RunFailure> {
             fallbacks: seed % 2,
             degraded_plans: 0,
             plans: 10,
+            commonroad: None,
         },
         vehicles: vec![
             vehicle("ego", seed, salt),

@@ -7,6 +7,10 @@
 //!   `error` (string, null unless failed);
 //! - every run-level figure of the JSONL rows (`collisions`, `near_miss`, `min_ttc_s`,
 //!   `min_ttc_never`, ...), null for a failed run;
+//! - on a CommonRoad road only (`--scenario file.xml`, or `[sim.road] commonroad`):
+//!   `recorded_traffic` (string: `none`, `replay`, `reactive`), `collisions_caused_by_replay`
+//!   (uint64), `min_gap_to_recorded_m`, `min_ttc_to_recorded_s` (float64), `goal_reached`
+//!   (boolean), `goal_time_s` (float64), null for a failed run;
 //! - `drawn.<name>` (float64): the values the scenario drew (`drawn.sim.mu`,
 //!   `drawn.vehicles.obstacle.speed_mps`, ...);
 //! - `<vehicle>.<figure>` per vehicle (`ego.min_speed_mps`, `obstacle.slowing_onset_s`,
@@ -135,6 +139,28 @@ fn run_cells(m: Option<&RunMetrics>) -> [(&'static str, Cell); 15] {
     ]
 }
 
+/// The figures of a run on a CommonRoad road, after its `recorded_traffic` text column (nulls
+/// of the same types for a failed run).
+fn commonroad_cells(m: Option<&RunMetrics>) -> [(&'static str, Cell); 5] {
+    let c = m.and_then(|m| m.commonroad.as_ref());
+    [
+        (
+            "collisions_caused_by_replay",
+            Cell::U64(c.map(|c| c.collisions_caused_by_replay)),
+        ),
+        (
+            "min_gap_to_recorded_m",
+            Cell::F64(c.and_then(|c| c.min_gap_to_recorded_m)),
+        ),
+        (
+            "min_ttc_to_recorded_s",
+            Cell::F64(c.and_then(|c| c.min_ttc_to_recorded_s)),
+        ),
+        ("goal_reached", Cell::Bool(c.and_then(|c| c.goal_reached))),
+        ("goal_time_s", Cell::F64(c.and_then(|c| c.goal_time_s))),
+    ]
+}
+
 /// A vehicle's figures (nulls of the same types when the row has no such vehicle).
 fn vehicle_cells(v: Option<&VehicleRow>) -> [(&'static str, Cell); 28] {
     let f = |f: fn(&VehicleRow) -> f64| Cell::F64(v.map(f));
@@ -231,6 +257,15 @@ pub fn record_batch(rows: &[&RunRow], sweep_seed: u64) -> Result<RecordBatch, Pa
     for (name, cell) in run_cells(None) {
         columns.push((name.into(), true, Column::of(cell)));
     }
+    let on_commonroad = rows
+        .iter()
+        .any(|r| r.metrics.as_ref().is_some_and(|m| m.commonroad.is_some()));
+    if on_commonroad {
+        columns.push(("recorded_traffic".into(), true, Column::Text(Vec::new())));
+        for (name, cell) in commonroad_cells(None) {
+            columns.push((name.into(), true, Column::of(cell)));
+        }
+    }
     for name in &drawn_names {
         columns.push((format!("drawn.{name}"), true, Column::F64(Vec::new())));
     }
@@ -255,6 +290,10 @@ pub fn record_batch(rows: &[&RunRow], sweep_seed: u64) -> Result<RecordBatch, Pa
             Cell::Bool(None),
         ];
         cells.extend(run_cells(row.metrics.as_ref()).map(|(_, c)| c));
+        if on_commonroad {
+            cells.push(Cell::Bool(None));
+            cells.extend(commonroad_cells(row.metrics.as_ref()).map(|(_, c)| c));
+        }
         cells.extend(
             drawn_names
                 .iter()
@@ -268,6 +307,10 @@ pub fn record_batch(rows: &[&RunRow], sweep_seed: u64) -> Result<RecordBatch, Pa
             Some(row.planner.clone()),
             Some(status_name(row.status).to_string()),
             row.error.clone(),
+            row.metrics
+                .as_ref()
+                .and_then(|m| m.commonroad.as_ref())
+                .map(|c| c.recorded_traffic.clone()),
         ];
         let mut texts = texts.into_iter();
         for ((_, _, column), cell) in columns.iter_mut().zip(cells) {

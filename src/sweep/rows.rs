@@ -50,6 +50,47 @@ pub struct RunMetrics {
     pub degraded_plans: u64,
     /// Planner cycles.
     pub plans: u64,
+    /// The figures of a run on a CommonRoad road (`None` on any other road, and then not
+    /// written): written flat beside the others, read back by [`RunRow`]'s reader.
+    #[serde(skip)]
+    pub commonroad: Option<CommonRoadFigures>,
+}
+
+/// The figures of a run on a CommonRoad road (as `merge_sim run --json` reports them): written
+/// in the rows of a sweep of such a scenario only, so the rows of every other sweep are as
+/// before.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CommonRoadFigures {
+    /// How the file's recorded traffic moved: `none`, `replay` or `reactive`.
+    pub recorded_traffic: String,
+    /// Collisions in which a recorded vehicle ran into a simulated one from behind (counted
+    /// apart from `collisions`).
+    pub collisions_caused_by_replay: u64,
+    /// Minimum distance between a simulated and a recorded vehicle's boxes (m); null when no
+    /// recorded vehicle came within `pair_range_m` (or none is spawned: mode `none`).
+    pub min_gap_to_recorded_m: Option<f64>,
+    /// Minimum time to collision between a simulated and a recorded vehicle (s); null if no
+    /// such pair was ever closing within the horizon.
+    pub min_ttc_to_recorded_s: Option<f64>,
+    /// Whether the ego reached its goal (the file's planning problem); null without a goal
+    /// (a scenario TOML on a CommonRoad road).
+    pub goal_reached: Option<bool>,
+    /// When it first met its goal (s); null if it did not or has none.
+    pub goal_time_s: Option<f64>,
+}
+
+impl CommonRoadFigures {
+    /// The figures of a run summary, if its scenario is on a CommonRoad road.
+    pub fn of(summary: &RunSummary) -> Option<Self> {
+        Some(CommonRoadFigures {
+            recorded_traffic: summary.recorded_traffic.clone()?,
+            collisions_caused_by_replay: summary.collisions_caused_by_replay as u64,
+            min_gap_to_recorded_m: summary.min_gap_to_recorded_m,
+            min_ttc_to_recorded_s: summary.min_ttc_to_recorded_s,
+            goal_reached: summary.goal_reached,
+            goal_time_s: summary.goal_time_s,
+        })
+    }
 }
 
 impl RunMetrics {
@@ -80,6 +121,7 @@ impl RunMetrics {
             fallbacks: summary.planner_stats.fallbacks,
             degraded_plans: summary.planner_stats.degraded_plans,
             plans: summary.planner_stats.plans,
+            commonroad: CommonRoadFigures::of(summary),
         }
     }
 }
@@ -105,6 +147,8 @@ struct MetricsOut<'a> {
     metrics: &'a RunMetrics,
     min_ttc_never: bool,
     min_gap_never: bool,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    commonroad: Option<&'a CommonRoadFigures>,
 }
 
 /// A vehicle's figures as written: its figures and their "never" flags.
@@ -188,6 +232,7 @@ impl Serialize for RunRow {
                 metrics: m,
                 min_ttc_never: m.min_ttc_never(),
                 min_gap_never: m.min_gap_never(),
+                commonroad: m.commonroad.as_ref(),
             }),
             vehicles: self
                 .vehicles
@@ -239,13 +284,19 @@ impl<'de> Deserialize<'de> for RunRow {
         };
         let (metrics, vehicles) = match raw.status {
             RunStatus::Completed => {
-                let metrics = RunMetrics::deserialize(serde_json::Value::Object(raw.rest))
-                    .map_err(|e| {
-                        D::Error::custom(format!(
-                            "instance {instance} ({planner}): a completed run with missing or \
-                             malformed figures: {e}"
-                        ))
-                    })?;
+                let malformed = |e: serde_json::Error| {
+                    D::Error::custom(format!(
+                        "instance {instance} ({planner}): a completed run with missing or \
+                         malformed figures: {e}"
+                    ))
+                };
+                let on_commonroad = raw.rest.contains_key("recorded_traffic");
+                let rest = serde_json::Value::Object(raw.rest);
+                let mut metrics = RunMetrics::deserialize(&rest).map_err(malformed)?;
+                if on_commonroad {
+                    metrics.commonroad =
+                        Some(CommonRoadFigures::deserialize(&rest).map_err(malformed)?);
+                }
                 let vehicles = raw_vehicles.ok_or_else(|| {
                     D::Error::custom(format!(
                         "instance {instance} ({planner}): a completed run without `vehicles`, \

@@ -86,6 +86,24 @@ pub struct SweepSummary {
     pub fallbacks: u64,
     /// Completed runs with at least one fallback.
     pub runs_with_fallbacks: u64,
+    /// How the recorded traffic of the scenario's CommonRoad road moved (`none`, `replay`,
+    /// `reactive`), read off the completed runs; absent (with the four figures below) for a
+    /// scenario on no CommonRoad road.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recorded_traffic: Option<String>,
+    /// Collisions caused by the replay of recorded traffic, summed over the completed runs
+    /// (not in `collisions`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collisions_caused_by_replay: Option<u64>,
+    /// Completed runs with at least one collision caused by the replay.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub runs_with_collisions_caused_by_replay: Option<u64>,
+    /// Completed runs whose ego has a goal (the file's planning problem).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub runs_with_goal: Option<u64>,
+    /// Of those, the runs whose ego reached its goal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goals_reached: Option<u64>,
     /// Wall-clock time (s): of the sweep, or the sum over merged shards. Not reproducible.
     pub wall_time_s: f64,
     /// The runs, in instance order.
@@ -191,6 +209,12 @@ impl SweepSummary {
         };
         let mean_of =
             |f: &dyn Fn(&RunMetrics) -> f64| mean(&done.iter().map(|m| f(m)).collect::<Vec<_>>());
+        let on_road: Vec<&super::CommonRoadFigures> =
+            done.iter().filter_map(|m| m.commonroad.as_ref()).collect();
+        let on_commonroad = !on_road.is_empty();
+        let count_on_road = |f: &dyn Fn(&super::CommonRoadFigures) -> bool| {
+            on_commonroad.then(|| on_road.iter().filter(|c| f(c)).count() as u64)
+        };
         let panicked = rows
             .iter()
             .filter(|r| r.status == RunStatus::Panicked)
@@ -227,6 +251,14 @@ impl SweepSummary {
             mean_min_speed_mps: mean_of(&|m| m.min_speed_mps),
             fallbacks: done.iter().map(|m| m.fallbacks).sum(),
             runs_with_fallbacks: count(&|m| m.fallbacks > 0),
+            recorded_traffic: on_road.first().map(|c| c.recorded_traffic.clone()),
+            collisions_caused_by_replay: on_commonroad
+                .then(|| on_road.iter().map(|c| c.collisions_caused_by_replay).sum()),
+            runs_with_collisions_caused_by_replay: count_on_road(&|c| {
+                c.collisions_caused_by_replay > 0
+            }),
+            runs_with_goal: count_on_road(&|c| c.goal_reached.is_some()),
+            goals_reached: count_on_road(&|c| c.goal_reached == Some(true)),
             wall_time_s,
             samples: rows,
         }
@@ -320,16 +352,33 @@ impl SweepSummary {
             opt(self.mean_min_speed_mps, 2),
             self.fallbacks,
             self.runs_with_fallbacks,
-        ) + &if self.missing_runs > 0 {
-            format!(
-                "INCOMPLETE: {} of {} runs missing (interrupted); the figures above are over the \
+        ) + &self.commonroad_lines()
+            + &if self.missing_runs > 0 {
+                format!(
+                    "INCOMPLETE: {} of {} runs missing (interrupted); the figures above are over the \
                  finished runs only\n",
-                self.missing_runs,
-                self.instances[1] - self.instances[0]
-            )
-        } else {
-            String::new()
-        }
+                    self.missing_runs,
+                    self.instances[1] - self.instances[0]
+                )
+            } else {
+                String::new()
+            }
+    }
+
+    /// The line of the CommonRoad figures (nothing on any other road).
+    fn commonroad_lines(&self) -> String {
+        let Some(mode) = &self.recorded_traffic else {
+            return String::new();
+        };
+        let goals = match (self.runs_with_goal, self.goals_reached) {
+            (Some(n), Some(k)) if n > 0 => format!("  goal reached in {k} of {n} runs"),
+            _ => String::new(),
+        };
+        format!(
+            "recorded traffic {mode}: collisions caused by replay {} (in {} runs){goals}\n",
+            self.collisions_caused_by_replay.unwrap_or(0),
+            self.runs_with_collisions_caused_by_replay.unwrap_or(0),
+        )
     }
 
     /// One JSONL line (without the newline): `row` with the sweep's identity and `wall_time_s`.

@@ -42,6 +42,7 @@ fn fake(seed: u64) -> Result<RunMetrics, RunFailure> {
         fallbacks: seed % 2,
         degraded_plans: 0,
         plans: 10,
+        commonroad: None,
     })
 }
 
@@ -347,4 +348,84 @@ fn run_and_thread_counts_are_bounded() {
     )
     .unwrap_err();
     assert!(err.to_string().contains("threads = 1025"), "{err}");
+}
+
+/// The fake run on a CommonRoad road: its figures, with the recorded traffic's.
+fn fake_on_commonroad(seed: u64) -> Result<RunMetrics, RunFailure> {
+    fake(seed).map(|m| RunMetrics {
+        commonroad: Some(CommonRoadFigures {
+            recorded_traffic: "replay".into(),
+            collisions_caused_by_replay: seed % 3,
+            min_gap_to_recorded_m: (!seed.is_multiple_of(4)).then_some(0.5),
+            min_ttc_to_recorded_s: None,
+            goal_reached: Some(seed.is_multiple_of(2)),
+            goal_time_s: seed.is_multiple_of(2).then_some(4.25),
+        }),
+        ..m
+    })
+}
+
+#[test]
+fn commonroad_figures_are_written_read_back_and_aggregated() {
+    let plan = plan(12, Shard::WHOLE);
+    let outcome = run_sweep_with(&plan, &SweepOptions::default(), &|_| {}, fake_on_commonroad)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let s = &outcome.summary;
+    let done: Vec<&CommonRoadFigures> = s
+        .samples
+        .iter()
+        .filter_map(|r| r.metrics.as_ref()?.commonroad.as_ref())
+        .collect();
+    assert!(!done.is_empty());
+    assert_eq!(s.recorded_traffic.as_deref(), Some("replay"));
+    assert_eq!(
+        s.collisions_caused_by_replay,
+        Some(done.iter().map(|c| c.collisions_caused_by_replay).sum())
+    );
+    assert_eq!(
+        s.runs_with_collisions_caused_by_replay,
+        Some(
+            done.iter()
+                .filter(|c| c.collisions_caused_by_replay > 0)
+                .count() as u64
+        )
+    );
+    assert_eq!(s.runs_with_goal, Some(done.len() as u64));
+    assert!(
+        s.table()
+            .contains("recorded traffic replay: collisions caused by replay")
+    );
+    for row in &s.samples {
+        let text = serde_json::to_string(row).unwrap_or_default();
+        let back: RunRow = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}: {text}"));
+        assert_eq!(&back, row);
+        // A malformed figure is an error naming the instance, never dropped silently.
+        if row.metrics.is_some() {
+            let bad = text.replace(
+                "\"collisions_caused_by_replay\":",
+                "\"collisions_caused_by_replay\":\"x\",\"_\":",
+            );
+            let e = serde_json::from_str::<RunRow>(&bad)
+                .err()
+                .map(|e| e.to_string());
+            assert!(
+                e.as_deref()
+                    .is_some_and(|e| e.contains(&format!("instance {}", row.instance))),
+                "{e:?}"
+            );
+        }
+    }
+    // Without a CommonRoad road nothing is added.
+    let plain = run_sweep_with(&plan, &SweepOptions::default(), &|_| {}, fake)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(plain.summary.recorded_traffic, None);
+    let json = serde_json::to_value(&plain.summary).unwrap_or_default();
+    for key in [
+        "recorded_traffic",
+        "collisions_caused_by_replay",
+        "goals_reached",
+    ] {
+        assert!(json.get(key).is_none(), "{key}");
+        assert!(json["samples"][0].get(key).is_none(), "{key}");
+    }
 }

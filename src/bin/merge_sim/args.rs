@@ -133,8 +133,9 @@ pub(crate) struct RunArgs {
     /// The instance index of --sweep-seed (a sweep row's `instance`).
     #[arg(long, value_name = "I", requires = "sweep_seed")]
     pub(crate) instance: Option<u64>,
-    /// Where to write the Rerun recording [default: <scenario>_<planner>.rrd; none in a build
-    /// without the cargo feature `rerun`].
+    /// Where to write the Rerun recording [default: <scenario>_<planner>.rrd, on a CommonRoad
+    /// road <scenario>_<planner>[_<mode>][_<D>s].rrd (the --recorded-traffic mode unless
+    /// `replay`, the --duration if given); none in a build without the cargo feature `rerun`].
     #[arg(long, value_name = "PATH", conflicts_with = "no_rrd")]
     pub(crate) rrd: Option<PathBuf>,
     /// Do not write a Rerun recording.
@@ -358,7 +359,10 @@ pub(crate) struct SweepArgs {
     /// Append one JSON line per run here as it finishes (the sweep's identity with its
     /// planners, instance, planner, seed, status, the drawn values under `drawn`, the figures,
     /// each vehicle's figures under `vehicles`, wall time), flushed at once, so an interrupted
-    /// sweep loses no finished run. An existing file is refused unless --resume is given.
+    /// sweep loses no finished run. On a CommonRoad road a completed run's figures add
+    /// `recorded_traffic` (the mode), `collisions_caused_by_replay`, `min_gap_to_recorded_m`,
+    /// `min_ttc_to_recorded_s`, `goal_reached`, `goal_time_s` (also in --json and --parquet).
+    /// An existing file is refused unless --resume is given.
     #[arg(long, value_name = "PATH")]
     pub(crate) jsonl: Option<PathBuf>,
     /// Complete an interrupted sweep: read the --jsonl file of the same sweep (same scenario,
@@ -432,9 +436,11 @@ pub(crate) struct GridArgs {
     /// Sweep seed of the drawn instances (decimal or 0x hex).
     #[arg(long, default_value = "0", value_name = "K", value_parser = parse_seed)]
     pub(crate) seed: u64,
-    /// Vehicle whose figures the table and the figure compare.
-    #[arg(long, default_value = "obstacle", value_name = "NAME")]
-    pub(crate) vehicle: String,
+    /// Vehicle whose figures the table and the figure compare [default: the scenario's
+    /// vehicle named `obstacle` (the built-in merges' merging car), else its first vehicle not
+    /// named `ego`, else its first vehicle (the ego of a CommonRoad file)].
+    #[arg(long, value_name = "NAME")]
+    pub(crate) vehicle: Option<String>,
     /// Write every run (one line per run and vehicle) here.
     #[arg(long, value_name = "PATH")]
     pub(crate) csv: Option<PathBuf>,

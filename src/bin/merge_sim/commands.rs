@@ -63,8 +63,29 @@ pub(crate) fn progress_bar(quiet: bool, len: u64, message: String) -> indicatif:
 /// Recordings estimated above this size are announced before they are written.
 const RECORDING_WARNING_BYTES: f64 = 500e6;
 
-pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failure> {
+/// The default recording of a run: `<scenario>_<planner>.rrd`; on a CommonRoad road, with
+/// `_<mode>` when its recorded traffic is not replayed (the default) and `_<duration>s` when
+/// `--duration` is given, so that runs of one file in different modes do not overwrite each
+/// other.
+fn default_rrd(scenario: &Scenario, label: &str, duration_s: Option<f64>) -> PathBuf {
     use mergesim::output::file_name_part;
+    let mut stem = format!(
+        "{}_{}",
+        file_name_part(&scenario.name),
+        file_name_part(label)
+    );
+    if let Some(road) = scenario.sim.commonroad_road() {
+        if road.recorded_traffic != sim::recorded_traffic::TrafficMode::Replay {
+            stem.push_str(&format!("_{}", road.recorded_traffic));
+        }
+        if let Some(d) = duration_s {
+            stem.push_str(&format!("_{}s", file_name_part(&d.to_string())));
+        }
+    }
+    PathBuf::from(format!("{stem}.rrd"))
+}
+
+pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failure> {
     let scenario = load_source(&args.source)?;
     let label = mergesim::sweep::planner_label(&scenario, args.planner);
     if !cfg!(feature = "rerun") && (args.rrd.is_some() || args.view) {
@@ -77,13 +98,11 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
     let rrd = if args.no_rrd || !cfg!(feature = "rerun") {
         None
     } else {
-        Some(args.rrd.clone().unwrap_or_else(|| {
-            PathBuf::from(format!(
-                "{}_{}.rrd",
-                file_name_part(&scenario.name),
-                file_name_part(&label)
-            ))
-        }))
+        Some(
+            args.rrd
+                .clone()
+                .unwrap_or_else(|| default_rrd(&scenario, &label, args.source.duration)),
+        )
     };
     check_outputs(
         &[
@@ -424,22 +443,32 @@ pub(crate) fn cmd_scenario(cmd: &ScenarioCommand) -> Result<(), Failure> {
     Ok(())
 }
 
+/// The vehicle a grid compares: `--vehicle` if it names one of the scenario's, else (without
+/// `--vehicle`) the one named `obstacle`, else the first not named `ego`, else the first.
+fn grid_vehicle(scenario: &Scenario, asked: Option<&str>) -> Result<String, Failure> {
+    let names: Vec<&str> = scenario.vehicles.iter().map(|v| v.name.as_str()).collect();
+    let chosen = match asked {
+        Some(name) => names.iter().find(|n| **n == name),
+        None => names
+            .iter()
+            .find(|n| **n == "obstacle")
+            .or_else(|| names.iter().find(|n| **n != "ego"))
+            .or_else(|| names.first()),
+    };
+    chosen.map(|n| n.to_string()).ok_or_else(|| {
+        input(anyhow!(
+            "--vehicle {:?}: no such vehicle in scenario {} (vehicles: {})",
+            asked.unwrap_or_default(),
+            scenario.name,
+            names.join(", ")
+        ))
+    })
+}
+
 pub(crate) fn cmd_grid(args: &GridArgs, interrupt: &Interrupt) -> Result<(), Failure> {
     use mergesim::grid::{GridAxes, GridMetric, GridPlan, MAX_GRID_RUNS, job_count, run_grid};
     let scenario = load_source(&args.source)?;
-    if !scenario.vehicles.iter().any(|v| v.name == args.vehicle) {
-        return Err(input(anyhow!(
-            "--vehicle {:?}: no such vehicle in scenario {} (vehicles: {})",
-            args.vehicle,
-            scenario.name,
-            scenario
-                .vehicles
-                .iter()
-                .map(|v| v.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
-        )));
-    }
+    let vehicle = grid_vehicle(&scenario, args.vehicle.as_deref())?;
     if args.runs > MAX_GRID_RUNS {
         return Err(input(anyhow!(
             "--runs {}: at most {MAX_GRID_RUNS} instances per cell",
@@ -490,15 +519,15 @@ pub(crate) fn cmd_grid(args: &GridArgs, interrupt: &Interrupt) -> Result<(), Fai
     }
     let outcome = outcome.map_err(|e| run_failure(anyhow!(e)))?;
     bar.finish_and_clear();
-    let peak = outcome.paired_differences(&args.vehicle, GridMetric::PeakYawRate);
-    let zone = outcome.paired_differences(&args.vehicle, GridMetric::MergeZoneRmsYawRate);
+    let peak = outcome.paired_differences(&vehicle, GridMetric::PeakYawRate);
+    let zone = outcome.paired_differences(&vehicle, GridMetric::MergeZoneRmsYawRate);
     if let Some(path) = &args.csv {
         write_output(path, &outcome.csv())?;
     }
     if let Some(path) = &args.json {
         let value = serde_json::json!({
             "grid": &outcome,
-            "vehicle": &args.vehicle,
+            "vehicle": &vehicle,
             "paired_peak_yaw_rate": &peak,
             "paired_merge_zone_rms_yaw_rate": &zone,
         });
@@ -509,14 +538,14 @@ pub(crate) fn cmd_grid(args: &GridArgs, interrupt: &Interrupt) -> Result<(), Fai
         mergesim::grid_plot::write_grid_png(
             path,
             &outcome,
-            &args.vehicle,
+            &vehicle,
             GridMetric::PeakYawRate,
             &caption,
         )
         .map_err(run_failure)?;
     }
     if !args.quiet {
-        out!("{}", grid_table(&outcome, &args.vehicle));
+        out!("{}", grid_table(&outcome, &vehicle));
         if outcome.axes.cells().len() == 1 {
             out!("{}", study_table(&outcome));
         }
