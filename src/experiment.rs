@@ -49,6 +49,15 @@ pub struct Finished {
     pub outcome: RunOutcome,
 }
 
+/// The message for a planner name `registry` does not hold (the same from the CLI, the library
+/// and Python): `unknown planner 'NAME'; valid: A, B, …`.
+pub fn unknown_planner(registry: &BehaviourRegistry, name: &str) -> String {
+    format!(
+        "unknown planner '{name}'; valid: {}",
+        registry.names().join(", ")
+    )
+}
+
 /// The planner label of a run: the override, or the scenario's single planner, or `mixed`
 /// (`none` without any planner-driven vehicle).
 pub fn planner_label(scenario: &Scenario, planner: Option<&str>) -> String {

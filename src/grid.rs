@@ -23,8 +23,9 @@ use planner::{PlannerKind, PlannerParams};
 use rayon::prelude::*;
 use scenarios::Scenario;
 use serde::{Deserialize, Serialize};
+use sim::BehaviourRegistry;
 
-use crate::experiment::{InstanceOptions, run_quietly};
+use crate::experiment::{InstanceOptions, run_instance};
 
 use crate::sweep::instance_seed;
 
@@ -193,8 +194,10 @@ pub const MAX_GRID_RUNS: u64 = 10_000;
 pub struct GridPlan {
     /// The scenario (its parameter set is the base of every cell).
     pub scenario: Scenario,
-    /// Planners, the first being the reference of the paired differences.
-    pub planners: Vec<PlannerKind>,
+    /// Planners by registered name, the first being the reference of the paired differences.
+    pub planners: Vec<String>,
+    /// The registry the names are looked up in (a user's planners among the built-ins).
+    pub registry: std::sync::Arc<BehaviourRegistry>,
     /// The axes.
     pub axes: GridAxes,
     /// 0: the nominal scenario only; else this many drawn instances.
@@ -209,9 +212,9 @@ pub struct GridPlan {
 }
 
 /// Runs of one (cell, planner) job.
-struct Job {
+struct Job<'a> {
     cell: GridCell,
-    planner: PlannerKind,
+    planner: &'a str,
     instance: u64,
     seed: Option<u64>,
 }
@@ -241,19 +244,27 @@ fn figures(outcome: &sim::RunOutcome) -> Vec<VehicleFigures> {
 
 fn run_job(
     scenario: &Scenario,
-    job: &Job,
+    job: &Job<'_>,
+    registry: &BehaviourRegistry,
     interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 ) -> GridRow {
     let mut cell_scenario = scenario.clone();
     cell_scenario.sim.planner = job.cell.apply(&scenario.sim.planner);
     let options = InstanceOptions {
-        planner: Some(job.planner.name().to_string()),
+        planner: Some(job.planner.to_string()),
         seed: job.seed,
         keep_time_series: false,
         interrupt,
         profile: false,
     };
-    let result = run_quietly(&cell_scenario, &options).map(|finished| finished.outcome);
+    let result = run_instance(
+        &cell_scenario,
+        &options,
+        sim::recording::Recorder::disabled(),
+        registry,
+        |_| {},
+    )
+    .map(|finished| finished.outcome);
     let (collisions, error, vehicles) = match result {
         Ok(outcome) => (
             Some((outcome.safety.own_collisions() + outcome.safety.edge_contacts.len()) as u64),
@@ -264,7 +275,7 @@ fn run_job(
     };
     GridRow {
         cell: job.cell,
-        planner: job.planner.name().to_string(),
+        planner: job.planner.to_string(),
         instance: job.instance,
         seed: job.seed,
         collisions,
@@ -301,6 +312,17 @@ pub fn run_grid(plan: &GridPlan, on_run_done: &(dyn Fn() + Sync)) -> Result<Grid
     if plan.planners.is_empty() {
         return Err("--planners: need at least one planner".into());
     }
+    for (i, name) in plan.planners.iter().enumerate() {
+        if !plan.registry.contains(name) {
+            return Err(format!(
+                "--planners: {}",
+                crate::experiment::unknown_planner(&plan.registry, name)
+            ));
+        }
+        if plan.planners[..i].contains(name) {
+            return Err(format!("--planners: {name} is listed twice"));
+        }
+    }
     let cells = plan.axes.cells();
     if cells.is_empty() {
         return Err("the grid has no cell".into());
@@ -315,8 +337,8 @@ pub fn run_grid(plan: &GridPlan, on_run_done: &(dyn Fn() + Sync)) -> Result<Grid
     // Jobs: interaction-free planners once per (prediction, sub-steps, τ).
     let mut jobs = Vec::new();
     for cell in &cells {
-        for &planner in &plan.planners {
-            let representative = if planner.is_interactive() {
+        for planner in &plan.planners {
+            let representative = if is_interactive(planner) {
                 *cell
             } else {
                 GridCell {
@@ -330,7 +352,7 @@ pub fn run_grid(plan: &GridPlan, on_run_done: &(dyn Fn() + Sync)) -> Result<Grid
             for &(instance, seed) in &instances {
                 jobs.push(Job {
                     cell: *cell,
-                    planner,
+                    planner: planner.as_str(),
                     instance,
                     seed,
                 });
@@ -346,7 +368,7 @@ pub fn run_grid(plan: &GridPlan, on_run_done: &(dyn Fn() + Sync)) -> Result<Grid
     let ran: Vec<GridRow> = pool.install(|| {
         jobs.par_iter()
             .map(|job| {
-                let row = run_job(&plan.scenario, job, plan.interrupt.clone());
+                let row = run_job(&plan.scenario, job, &plan.registry, plan.interrupt.clone());
                 on_run_done();
                 row
             })
@@ -362,8 +384,8 @@ pub fn run_grid(plan: &GridPlan, on_run_done: &(dyn Fn() + Sync)) -> Result<Grid
     // Every cell gets a row for every planner and instance (shared rows copied in).
     let mut rows = Vec::new();
     for cell in &cells {
-        for &planner in &plan.planners {
-            let source_cell = if planner.is_interactive() {
+        for planner in &plan.planners {
+            let source_cell = if is_interactive(planner) {
                 *cell
             } else {
                 GridCell {
@@ -373,7 +395,7 @@ pub fn run_grid(plan: &GridPlan, on_run_done: &(dyn Fn() + Sync)) -> Result<Grid
             };
             for row in ran
                 .iter()
-                .filter(|r| r.cell == source_cell && r.planner == planner.name())
+                .filter(|r| r.cell == source_cell && r.planner == *planner)
             {
                 rows.push(GridRow {
                     cell: *cell,
@@ -386,12 +408,19 @@ pub fn run_grid(plan: &GridPlan, on_run_done: &(dyn Fn() + Sync)) -> Result<Grid
         scenario: plan.scenario.name.clone(),
         params: plan.scenario.params.name().to_string(),
         axes: plan.axes.clone(),
-        planners: plan.planners.iter().map(|p| p.name().to_string()).collect(),
+        planners: plan.planners.clone(),
         runs: plan.runs,
         seed: plan.seed,
         rows,
         wall_time_s: started.elapsed().as_secs_f64(),
     })
+}
+
+/// Whether the planner named `name` reads the interaction time gap τ_I (the interactive
+/// built-ins); a user's planner is taken to read it, so each of its cells runs on its own.
+fn is_interactive(name: &str) -> bool {
+    name.parse::<PlannerKind>()
+        .map_or(true, |kind| kind.is_interactive())
 }
 
 /// Number of runs [`run_grid`] performs (for the progress bar).
@@ -402,7 +431,7 @@ pub fn job_count(plan: &GridPlan) -> u64 {
     plan.planners
         .iter()
         .map(|p| {
-            if p.is_interactive() {
+            if is_interactive(p) {
                 cells
             } else {
                 shared_cells
@@ -422,7 +451,8 @@ mod tests {
         assert_eq!(axes.cells().len(), 48);
         let plan = GridPlan {
             scenario: Scenario::load("urgent_merge").unwrap(),
-            planners: vec![PlannerKind::PfCs, PlannerKind::PfIso],
+            planners: vec!["pf-cs".into(), "pf-iso".into()],
+            registry: std::sync::Arc::new(BehaviourRegistry::builtin()),
             axes,
             runs: 0,
             seed: 0,

@@ -37,8 +37,8 @@ use std::sync::atomic::AtomicBool;
 #[cfg(test)]
 use std::sync::atomic::Ordering;
 
-use planner::PlannerKind;
 use scenarios::Scenario;
+use sim::BehaviourRegistry;
 use sim::rng::SplitMix64;
 
 use thiserror::Error;
@@ -62,8 +62,9 @@ pub fn instance_seed(sweep_seed: u64, instance: u64) -> u64 {
 pub struct SweepPlan {
     /// The scenario (nominal values and randomisation ranges).
     pub scenario: Scenario,
-    /// Planner of every planner-driven vehicle (`None`: the scenario's own).
-    pub planner: Option<PlannerKind>,
+    /// Registered name of the planner of every planner-driven vehicle (`None`: the scenario's
+    /// own); looked up in [`SweepOptions::registry`].
+    pub planner: Option<String>,
     /// Instances in the whole sweep (≥ 1).
     pub runs: u64,
     /// Sweep seed K.
@@ -81,7 +82,8 @@ pub struct PairedSweepPlan {
     pub scenario: Scenario,
     /// Planners of every planner-driven vehicle, the first the baseline of the paired
     /// differences; empty: the scenario's own planners (one pass, like `planner: None`).
-    pub planners: Vec<PlannerKind>,
+    /// Registered names, looked up in [`SweepOptions::registry`].
+    pub planners: Vec<String>,
     /// Instances in the whole sweep (≥ 1); each runs once per planner.
     pub runs: u64,
     /// Sweep seed K.
@@ -92,11 +94,11 @@ pub struct PairedSweepPlan {
 
 impl PairedSweepPlan {
     /// The planner overrides in order (`[None]`: the scenario's own).
-    pub fn overrides(&self) -> Vec<Option<PlannerKind>> {
+    pub fn overrides(&self) -> Vec<Option<String>> {
         if self.planners.is_empty() {
             vec![None]
         } else {
-            self.planners.iter().copied().map(Some).collect()
+            self.planners.iter().cloned().map(Some).collect()
         }
     }
 
@@ -104,7 +106,7 @@ impl PairedSweepPlan {
     pub fn labels(&self) -> Vec<String> {
         self.overrides()
             .into_iter()
-            .map(|k| planner_label(&self.scenario, k))
+            .map(|k| planner_label(&self.scenario, k.as_deref()))
             .collect()
     }
 }
@@ -113,7 +115,7 @@ impl From<&SweepPlan> for PairedSweepPlan {
     fn from(plan: &SweepPlan) -> Self {
         PairedSweepPlan {
             scenario: plan.scenario.clone(),
-            planners: plan.planner.into_iter().collect(),
+            planners: plan.planner.iter().cloned().collect(),
             runs: plan.runs,
             seed: plan.seed,
             shard: plan.shard,
@@ -122,8 +124,12 @@ impl From<&SweepPlan> for PairedSweepPlan {
 }
 
 /// How to run a sweep (does not change its results).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct SweepOptions {
+    /// The planners by name: the plan's planners and the scenario's `driver = { planner = … }`
+    /// are looked up here ([`BehaviourRegistry::builtin`] by default; a user's registry adds
+    /// their own planners).
+    pub registry: Arc<BehaviourRegistry>,
     /// Worker threads (`None`: one per core; at most [`MAX_THREADS`]).
     pub threads: Option<usize>,
     /// Once set (e.g. by a SIGINT/SIGTERM handler), no run starts and running ones stop; the
@@ -132,6 +138,18 @@ pub struct SweepOptions {
     /// Runs finished by an earlier, interrupted attempt of the same sweep (`--resume`): their
     /// instances are not run again and their rows enter the aggregate as they are.
     pub resume: Vec<FinishedRun>,
+}
+
+impl Default for SweepOptions {
+    /// The built-in planners, one thread per core, no interrupt, nothing resumed.
+    fn default() -> Self {
+        Self {
+            registry: Arc::new(BehaviourRegistry::builtin()),
+            threads: None,
+            interrupt: None,
+            resume: Vec::new(),
+        }
+    }
 }
 
 /// Most instances of one sweep (a sweep keeps every row in memory, ≈ 200 bytes each; for more,
@@ -278,8 +296,8 @@ pub fn unrandomised_warning(scenario: &Scenario) -> Option<String> {
 }
 
 /// The planner name of a sweep: the override, or the scenario's single planner, or `mixed`.
-pub fn planner_label(scenario: &Scenario, planner: Option<PlannerKind>) -> String {
-    crate::experiment::planner_label(scenario, planner.map(|k| k.name()))
+pub fn planner_label(scenario: &Scenario, planner: Option<&str>) -> String {
+    crate::experiment::planner_label(scenario, planner)
 }
 
 /// Runs instance `seed` of the plan's scenario: what `merge_sim run --seed <seed>` runs.
@@ -293,29 +311,52 @@ pub fn simulate_instance_until(
     seed: u64,
     interrupt: Option<Arc<AtomicBool>>,
 ) -> Result<RunSummary, sim::SimError> {
-    simulate_run(&plan.scenario, plan.planner, seed, interrupt)
+    simulate_run(&plan.scenario, plan.planner.as_deref(), seed, interrupt)
 }
 
-/// Runs instance `seed` of `scenario` with `planner` (`None`: the scenario's own): what
-/// `merge_sim run --scenario S [--planner P] --seed <seed>` runs.
+/// Runs instance `seed` of `scenario` with `planner` (`None`: the scenario's own) among the
+/// built-in planners: what `merge_sim run --scenario S [--planner P] --seed <seed>` runs.
 pub fn simulate_run(
     scenario: &Scenario,
-    planner: Option<PlannerKind>,
+    planner: Option<&str>,
     seed: u64,
     interrupt: Option<Arc<AtomicBool>>,
 ) -> Result<RunSummary, sim::SimError> {
+    simulate_run_with(
+        scenario,
+        planner,
+        seed,
+        interrupt,
+        &BehaviourRegistry::builtin(),
+    )
+}
+
+/// [`simulate_run`] with the planners of `registry` (a user's among them).
+pub fn simulate_run_with(
+    scenario: &Scenario,
+    planner: Option<&str>,
+    seed: u64,
+    interrupt: Option<Arc<AtomicBool>>,
+    registry: &BehaviourRegistry,
+) -> Result<RunSummary, sim::SimError> {
     let options = crate::experiment::InstanceOptions {
-        planner: planner.map(|k| k.name().to_string()),
+        planner: planner.map(str::to_string),
         seed: Some(seed),
         keep_time_series: false,
         interrupt,
         profile: false,
     };
-    crate::experiment::run_quietly(scenario, &options)
-        .map(|finished| finished.summary)
-        .map_err(|e| match e {
-            crate::experiment::RunError::Setup(e) | crate::experiment::RunError::Run(e) => e,
-        })
+    crate::experiment::run_instance(
+        scenario,
+        &options,
+        sim::recording::Recorder::disabled(),
+        registry,
+        |_| {},
+    )
+    .map(|finished| finished.summary)
+    .map_err(|e| match e {
+        crate::experiment::RunError::Setup(e) | crate::experiment::RunError::Run(e) => e,
+    })
 }
 
 /// Runs the plan's shard with the simulator; `on_run` is called with each run as it finishes
@@ -343,11 +384,12 @@ pub fn run_paired_sweep(
         plan,
         options,
         on_run,
-        |request: &RunRequest| match simulate_run(
+        |request: &RunRequest| match simulate_run_with(
             &plan.scenario,
-            request.planner,
+            request.planner.as_deref(),
             request.seed,
             interrupt.clone(),
+            &options.registry,
         ) {
             Ok(summary) => Ok(RunFigures::of(&summary)),
             Err(sim::SimError::Interrupted { .. }) => Err(RunFailure::Interrupted),

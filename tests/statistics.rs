@@ -22,7 +22,7 @@ const SEED: u64 = 20_240_601;
 fn sweep(planner: PlannerKind) -> SweepSummary {
     let plan = SweepPlan {
         scenario: Scenario::load("urgent_merge").unwrap(),
-        planner: Some(planner),
+        planner: Some(planner.name().to_string()),
         runs: RUNS,
         seed: SEED,
         shard: Shard::WHOLE,
@@ -114,9 +114,9 @@ fn obstacle_peaks(summary: &RunSummary) -> (f64, f64) {
 /// |r| −0.0042 ± 0.0006 rad/s; |ψ| −0.0064 ± 0.0008 rad.)
 #[test]
 fn pf_iso_keeps_the_obstacle_steadier_than_pf_cs_over_randomised_instances() {
-    let plan = |planner| SweepPlan {
+    let plan = |planner: PlannerKind| SweepPlan {
         scenario: Scenario::load("urgent_merge").unwrap(),
-        planner: Some(planner),
+        planner: Some(planner.name().to_string()),
         runs: RUNS,
         seed: SEED,
         shard: Shard::WHOLE,
@@ -160,7 +160,7 @@ fn pf_iso_pred_does_not_race_where_the_equilibria_meet() {
     for name in ["wet_road", "degraded_v2v"] {
         let plan = SweepPlan {
             scenario: Scenario::load(name).unwrap(),
-            planner: Some(PlannerKind::PfIsoPred),
+            planner: Some(PlannerKind::PfIsoPred.name().to_string()),
             runs: 100,
             seed: 42,
             shard: Shard::WHOLE,

@@ -20,7 +20,7 @@ fn without_v2v(name: &str, fallback: V2vLossFallback) -> Scenario {
 fn sweep(scenario: Scenario, runs: u64) -> SweepSummary {
     let plan = SweepPlan {
         scenario,
-        planner: Some(PlannerKind::PfIso),
+        planner: Some(PlannerKind::PfIso.name().to_string()),
         runs,
         seed: SEED,
         shard: Shard::WHOLE,

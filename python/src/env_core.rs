@@ -142,9 +142,13 @@ impl EnvCore {
         };
         let registry = BehaviourRegistry::builtin();
         // Checked as `merge_sim run --planner` checks it (the same message).
-        if let Some(name) = &planner {
-            name.parse::<planner::PlannerKind>()
-                .map_err(|e| BindingError::input(&e))?;
+        if let Some(name) = &planner
+            && !registry.contains(name)
+        {
+            return Err(BindingError::Input(mergesim::experiment::unknown_planner(
+                &registry, name,
+            ))
+            .into());
         }
         let command: SharedCommand = Arc::new(Mutex::new(Command {
             target_speed_mps: scenario.vehicles[agent].target_speed_mps,

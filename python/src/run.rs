@@ -23,8 +23,13 @@ pub fn run(
     let scenario = source::load(scenario, params_json)?;
     // Checked as `merge_sim run --planner` checks it (the same message).
     if let Some(name) = planner {
-        name.parse::<planner::PlannerKind>()
-            .map_err(|e| BindingError::input(&e))?;
+        let registry = sim::BehaviourRegistry::builtin();
+        if !registry.contains(name) {
+            return Err(BindingError::Input(mergesim::experiment::unknown_planner(
+                &registry, name,
+            ))
+            .into());
+        }
     }
     let planner = planner.map(str::to_string);
     let finished = run_interruptible(py, None, |interrupt| {

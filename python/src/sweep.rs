@@ -5,7 +5,6 @@
 use mergesim::sweep::{
     PairedSweepPlan, Shard, SweepError, SweepIdentity, SweepOptions, jsonl_line, run_paired_sweep,
 };
-use planner::PlannerKind;
 use pyo3::prelude::*;
 
 use crate::background::run_interruptible;
@@ -29,11 +28,6 @@ pub fn sweep(
     threads: Option<usize>,
 ) -> PyResult<Vec<String>> {
     let scenario = source::load(scenario, params_json)?;
-    let planners = planners
-        .iter()
-        .map(|name| name.parse::<PlannerKind>())
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| BindingError::input(&e))?;
     let plan = PairedSweepPlan {
         scenario,
         planners,

@@ -169,7 +169,7 @@ pub struct Analysis {
 pub fn analyse(plan: &StudyPlan, rows: &[StudyRow]) -> Analysis {
     let mut rows: Vec<StudyRow> = rows.to_vec();
     super::runner::sort_rows(plan, &mut rows);
-    let reference = plan.reference.name();
+    let reference = plan.reference.as_str();
     let find = |cell: usize, planner: &str, instance: u64| {
         rows.iter()
             .find(|r| r.cell == cell && r.planner == planner && r.instance == instance)
@@ -179,7 +179,7 @@ pub fn analyse(plan: &StudyPlan, rows: &[StudyRow]) -> Analysis {
     let mut collisions = Vec::new();
     for (cell, _) in &plan.cells {
         for planner in plan.planners.iter().filter(|p| **p != plan.reference) {
-            let name = planner.name();
+            let name = planner.as_str();
             let pairs: Vec<(&StudyRow, &StudyRow)> = (0..plan.instances)
                 .filter_map(|i| Some((find(cell.index, name, i)?, find(cell.index, reference, i)?)))
                 .collect();

@@ -3,7 +3,6 @@
 
 use std::path::{Path, PathBuf};
 
-use planner::PlannerKind;
 use scenarios::Scenario;
 use scenarios::source_location::line_of;
 use serde::{Deserialize, Serialize};
@@ -177,10 +176,10 @@ pub struct StudyPlan {
     pub scenario: Scenario,
     /// The cells and the scenario of each (factors applied, checked).
     pub cells: Vec<(Cell, Scenario)>,
-    /// Planners, in the plan's order.
-    pub planners: Vec<PlannerKind>,
+    /// Planners by registered name, in the plan's order.
+    pub planners: Vec<String>,
     /// The reference planner (one of `planners`).
-    pub reference: PlannerKind,
+    pub reference: String,
     /// Instances per cell and planner.
     pub instances: u64,
     /// Seed K of the instances: instance i runs with `sweep::instance_seed(K, i)`.
@@ -209,8 +208,14 @@ impl StudyPlan {
         format!("{:016x}", scenarios::randomisation::fnv1a64(&self.text))
     }
 
-    /// Loads and checks the plan at `path`.
+    /// Loads and checks the plan at `path`, its planners among the built-in ones.
     pub fn load(path: &Path) -> Result<Self, PlanError> {
+        Self::load_with(path, &sim::BehaviourRegistry::builtin())
+    }
+
+    /// Loads and checks the plan at `path`, its planners among those of `registry` (a user's
+    /// planners by name).
+    pub fn load_with(path: &Path, registry: &sim::BehaviourRegistry) -> Result<Self, PlanError> {
         let text =
             mergesim_types::files::read_regular_text(path, MAX_PLAN_BYTES).map_err(|source| {
                 PlanError::Io {
@@ -218,11 +223,21 @@ impl StudyPlan {
                     source,
                 }
             })?;
-        Self::from_text(&text, path)
+        Self::from_text_with(&text, path, registry)
     }
 
-    /// Parses and checks `text`, the plan at `path` (relative paths start from its folder).
+    /// Parses and checks `text`, the plan at `path` (relative paths start from its folder), its
+    /// planners among the built-in ones.
     pub fn from_text(text: &str, path: &Path) -> Result<Self, PlanError> {
+        Self::from_text_with(text, path, &sim::BehaviourRegistry::builtin())
+    }
+
+    /// [`StudyPlan::from_text`] with the planners of `registry`.
+    pub fn from_text_with(
+        text: &str,
+        path: &Path,
+        registry: &sim::BehaviourRegistry,
+    ) -> Result<Self, PlanError> {
         let origin = path.display().to_string();
         let raw: RawPlan = toml::from_str(text).map_err(|e| PlanError::Parse {
             origin: origin.clone(),
@@ -243,24 +258,29 @@ impl StudyPlan {
         }
         .map_err(|e| invalid(&["scenario"], "scenario", e.to_string()))?;
         // Planners.
-        let mut planners = Vec::new();
+        let unknown = |name: &str| crate::experiment::unknown_planner(registry, name);
+        let mut planners: Vec<String> = Vec::new();
         for (i, name) in raw.planners.iter().enumerate() {
-            let kind: PlannerKind = name.parse().map_err(|e: planner::PlannerError| {
-                invalid(&["planners", &i.to_string()], "planners", e.to_string())
-            })?;
-            if planners.contains(&kind) {
+            if !registry.contains(name) {
+                return Err(invalid(
+                    &["planners", &i.to_string()],
+                    "planners",
+                    unknown(name),
+                ));
+            }
+            if planners.contains(name) {
                 return Err(invalid(
                     &["planners", &i.to_string()],
                     "planners",
                     format!("{name} is listed twice"),
                 ));
             }
-            planners.push(kind);
+            planners.push(name.clone());
         }
-        let reference: PlannerKind =
-            raw.reference.parse().map_err(|e: planner::PlannerError| {
-                invalid(&["reference"], "reference", e.to_string())
-            })?;
+        let reference = raw.reference.clone();
+        if !registry.contains(&reference) {
+            return Err(invalid(&["reference"], "reference", unknown(&reference)));
+        }
         if !planners.contains(&reference) {
             return Err(invalid(
                 &["reference"],

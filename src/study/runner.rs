@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::plan::StudyPlan;
-use crate::experiment::{InstanceOptions, RunError, run_quietly};
+use crate::experiment::{InstanceOptions, RunError, run_instance};
 use crate::sweep::{RunStatus, Shard, instance_seed};
 
 /// An endpoint's values in one run.
@@ -83,8 +83,11 @@ pub enum StudyError {
 }
 
 /// How to run a study (does not change its results).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct RunOptions {
+    /// The planners by name ([`sim::BehaviourRegistry::builtin`] by default; the registry the
+    /// plan was checked against).
+    pub registry: Arc<sim::BehaviourRegistry>,
     /// Worker threads (`None`: one per core).
     pub threads: Option<usize>,
     /// The part to run.
@@ -95,6 +98,19 @@ pub struct RunOptions {
     pub resume: Vec<StudyRow>,
 }
 
+impl Default for RunOptions {
+    /// The built-in planners, one thread per core, the whole study, nothing resumed.
+    fn default() -> Self {
+        Self {
+            registry: Arc::new(sim::BehaviourRegistry::builtin()),
+            threads: None,
+            shard: None,
+            interrupt: None,
+            resume: Vec::new(),
+        }
+    }
+}
+
 /// The (cell, instance, planner) keys of the runs of `shard`, in (cell, planner, instance)
 /// order.
 pub fn run_keys(plan: &StudyPlan, shard: Shard) -> Vec<(usize, u64, String)> {
@@ -103,19 +119,20 @@ pub fn run_keys(plan: &StudyPlan, shard: Shard) -> Vec<(usize, u64, String)> {
     for (cell, _) in &plan.cells {
         for planner in &plan.planners {
             for instance in range.clone() {
-                keys.push((cell.index, instance, planner.name().to_string()));
+                keys.push((cell.index, instance, planner.clone()));
             }
         }
     }
     keys
 }
 
-/// Runs one (cell, instance, planner) of the plan.
+/// Runs one (cell, instance, planner) of the plan with the planners of `registry`.
 pub fn run_one(
     plan: &StudyPlan,
     cell: usize,
     instance: u64,
     planner: &str,
+    registry: &sim::BehaviourRegistry,
     interrupt: Option<Arc<AtomicBool>>,
 ) -> Option<StudyRow> {
     let seed = instance_seed(plan.seed, instance);
@@ -127,7 +144,15 @@ pub fn run_one(
         interrupt,
         profile: false,
     };
-    let result = catch_unwind(AssertUnwindSafe(|| run_quietly(scenario, &options)));
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        run_instance(
+            scenario,
+            &options,
+            sim::recording::Recorder::disabled(),
+            registry,
+            |_| {},
+        )
+    }));
     let mut row = StudyRow {
         cell,
         instance,
@@ -228,7 +253,14 @@ pub fn run_study(
                     return None;
                 }
                 let started = std::time::Instant::now();
-                let row = run_one(plan, *cell, *instance, planner, options.interrupt.clone())?;
+                let row = run_one(
+                    plan,
+                    *cell,
+                    *instance,
+                    planner,
+                    &options.registry,
+                    options.interrupt.clone(),
+                )?;
                 on_run(&row, started.elapsed().as_secs_f64());
                 Some(row)
             })
@@ -244,7 +276,7 @@ pub fn sort_rows(plan: &StudyPlan, rows: &mut [StudyRow]) {
     let order = |name: &str| {
         plan.planners
             .iter()
-            .position(|p| p.name() == name)
+            .position(|p| p == name)
             .unwrap_or(usize::MAX)
     };
     rows.sort_by(|a, b| {
@@ -295,7 +327,7 @@ pub fn read_rows(
         let row = parsed.row;
         if row.cell >= plan.cells.len()
             || row.instance >= plan.instances
-            || !plan.planners.iter().any(|p| p.name() == row.planner)
+            || !plan.planners.contains(&row.planner)
             || row.seed != instance_seed(plan.seed, row.instance)
         {
             return Err(StudyError::Invalid(format!(

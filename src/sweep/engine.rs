@@ -6,7 +6,6 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-use planner::PlannerKind;
 use rayon::prelude::*;
 
 use super::{
@@ -16,17 +15,18 @@ use super::{
 };
 
 /// One run a sweep asks its runner for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RunRequest {
     /// Instance index.
     pub instance: u64,
     /// The instance's seed ([`instance_seed`]).
     pub seed: u64,
-    /// The planner override (`None`: the scenario's own planners).
-    pub planner: Option<PlannerKind>,
+    /// The planner override, a registered name (`None`: the scenario's own planners).
+    pub planner: Option<String>,
 }
 
-/// Checks a multi-planner plan and its options before any work: the run and thread counts, no
+/// Checks a multi-planner plan and its options before any work: the run and thread counts,
+/// every planner registered in the options' registry (the plan's and the scenario's own), no
 /// planner listed twice, and that every resumed row belongs to the sweep (its shard, its seed,
 /// one of its planners) and appears once per (instance, planner).
 pub fn validate_paired(plan: &PairedSweepPlan, options: &SweepOptions) -> Result<(), SweepError> {
@@ -44,6 +44,7 @@ pub fn validate_paired(plan: &PairedSweepPlan, options: &SweepOptions) -> Result
             "threads = {threads}: need 1 to {MAX_THREADS}"
         )));
     }
+    check_planner_names(plan, &options.registry)?;
     let labels = plan.labels();
     for (i, label) in labels.iter().enumerate() {
         if labels[..i].contains(label) {
@@ -140,7 +141,7 @@ where
                 let request = RunRequest {
                     instance,
                     seed: instance_seed(plan.seed, instance),
-                    planner: overrides[p],
+                    planner: overrides[p].clone(),
                 };
                 let run_started = Instant::now();
                 let result = catch_unwind(AssertUnwindSafe(|| runner(&request)));
@@ -206,6 +207,40 @@ where
         new_runs: new_count,
         wall_time_s,
     })
+}
+
+/// Every planner the plan runs is in `registry`: the plan's list, and the scenario's own
+/// `driver = { planner = … }` (and prescribed drivers' `path_planner`) where the list does not
+/// replace them.
+fn check_planner_names(
+    plan: &PairedSweepPlan,
+    registry: &sim::BehaviourRegistry,
+) -> Result<(), SweepError> {
+    let unknown = |name: &str, whose: &str| {
+        SweepError::Invalid(format!(
+            "{whose}: {}",
+            crate::experiment::unknown_planner(registry, name)
+        ))
+    };
+    for name in &plan.planners {
+        if !registry.contains(name) {
+            return Err(SweepError::Invalid(crate::experiment::unknown_planner(
+                registry, name,
+            )));
+        }
+    }
+    for vehicle in &plan.scenario.vehicles {
+        match &vehicle.driver {
+            sim::Driver::Planner(name) if plan.planners.is_empty() && !registry.contains(name) => {
+                return Err(unknown(name, &format!("vehicle {}", vehicle.name)));
+            }
+            sim::Driver::Prescribed { path_planner, .. } if !registry.contains(path_planner) => {
+                return Err(unknown(path_planner, &format!("vehicle {}", vehicle.name)));
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {

@@ -4,12 +4,12 @@ use std::collections::BTreeMap;
 
 use super::*;
 
-const PLANNERS: [PlannerKind; 2] = [PlannerKind::PfCs, PlannerKind::PfIso];
+const PLANNERS: [&str; 2] = ["pf-cs", "pf-iso"];
 
 fn plan(runs: u64, shard: Shard) -> PairedSweepPlan {
     PairedSweepPlan {
         scenario: Scenario::load("urgent_merge").unwrap(),
-        planners: PLANNERS.to_vec(),
+        planners: PLANNERS.iter().map(|p| p.to_string()).collect(),
         runs,
         seed: 91,
         shard,
@@ -57,8 +57,8 @@ fn vehicle(name: &str, seed: u64, salt: u64) -> VehicleRow {
 /// instance and between instances, so a wrong pairing changes the paired statistics.
 fn fake(request: &RunRequest) -> Result<RunFigures, RunFailure> {
     let seed = request.seed;
-    let salt = match request.planner {
-        Some(PlannerKind::PfIso) => 7,
+    let salt = match request.planner.as_deref() {
+        Some("pf-iso") => 7,
         _ => 3,
     };
     if seed.is_multiple_of(13) && salt == 7 {
@@ -347,7 +347,7 @@ fn an_interrupted_then_resumed_paired_sweep_and_merged_shards_equal_the_whole() 
     assert_eq!(without_wall_time(&merged), without_wall_time(&whole));
     // A shard of a sweep with other planners is refused, naming its file.
     let mut other = plan(11, Shard::new(1, 3, "t").unwrap());
-    other.planners = vec![PlannerKind::PfCs, PlannerKind::PfSp];
+    other.planners = vec!["pf-cs".into(), "pf-sp".into()];
     let foreign = run_paired_sweep_with(&other, &options(1), &|_| {}, fake)
         .unwrap()
         .report();
@@ -392,11 +392,39 @@ fn an_interrupted_then_resumed_paired_sweep_and_merged_shards_equal_the_whole() 
 #[test]
 fn a_planner_listed_twice_is_refused() {
     let mut twice = plan(3, Shard::WHOLE);
-    twice.planners = vec![PlannerKind::PfIso, PlannerKind::PfIso];
+    twice.planners = vec!["pf-iso".into(), "pf-iso".into()];
     let err = run_paired_sweep_with(&twice, &SweepOptions::default(), &|_| panic!("ran"), fake)
         .unwrap_err()
         .to_string();
     assert!(err.contains("pf-iso is listed twice"), "{err}");
+}
+
+#[test]
+fn an_unregistered_planner_is_refused_before_any_run_and_a_registered_one_runs() {
+    let mut unknown = plan(3, Shard::WHOLE);
+    unknown.planners = vec!["pf-cs".into(), "mine".into()];
+    let err = run_paired_sweep_with(&unknown, &SweepOptions::default(), &|_| panic!("ran"), fake)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.starts_with("unknown planner 'mine'; valid: ") && err.contains("pf-iso"),
+        "{err}"
+    );
+    // The same name, registered, runs (the registry travels in the options).
+    let mut registry = sim::BehaviourRegistry::builtin();
+    let pf_cs_again: sim::BehaviourFactory =
+        std::sync::Arc::new(|input: &sim::FactoryInput<'_>| {
+            sim::BehaviourRegistry::builtin().create("pf-cs", input)
+        });
+    registry.register("mine", pf_cs_again).unwrap();
+    let options = SweepOptions {
+        registry: std::sync::Arc::new(registry),
+        threads: Some(1),
+        ..SweepOptions::default()
+    };
+    let outcome = run_paired_sweep_with(&unknown, &options, &|_| {}, fake).unwrap();
+    assert_eq!(outcome.summaries.len(), 2);
+    assert_eq!(outcome.summaries[1].samples[0].planner, "mine");
 }
 
 #[test]

@@ -5,7 +5,7 @@ use super::*;
 fn plan(runs: u64, shard: Shard) -> SweepPlan {
     SweepPlan {
         scenario: Scenario::load("urgent_merge").unwrap(),
-        planner: Some(PlannerKind::PfIso),
+        planner: Some("pf-iso".into()),
         runs,
         seed: 77,
         shard,

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use planner::{ParameterSet, PlannerKind};
+use planner::ParameterSet;
 
 /// Cooperative merge simulator: potential-field planners with interactive speed optimisation
 /// (Lin et al.) on physics-based Rapier vehicles.
@@ -116,7 +116,7 @@ pub(crate) struct RunArgs {
     pub(crate) source: ScenarioArgs,
     /// Planner of every planner-driven vehicle (overrides the scenario's choice).
     #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
-    pub(crate) planner: Option<PlannerKind>,
+    pub(crate) planner: Option<String>,
     /// Run the scenario instance drawn with seed N from its [randomise] ranges (N also seeds
     /// the V2V drops); a sweep's per-run rows give each run's seed, written as 0x and 16 hex
     /// digits (decimal is read too; a float such as 9.853264649648847e18 is refused: it lost
@@ -226,7 +226,7 @@ pub(crate) struct CompareArgs {
     /// Planners to compare, comma-separated.
     #[arg(long, value_delimiter = ',', value_parser = parse_planner,
           default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
-    pub(crate) planners: Vec<PlannerKind>,
+    pub(crate) planners: Vec<String>,
 
     /// Compare on the scenario instance drawn with seed N (as `run --seed N`: decimal or 0x
     /// hex); without it the nominal scenario.
@@ -301,8 +301,14 @@ pub(crate) enum ScenarioCommand {
     },
 }
 
-pub(crate) fn parse_planner(text: &str) -> Result<PlannerKind, String> {
-    text.parse::<PlannerKind>().map_err(|e| e.to_string())
+/// A registered planner name (the built-in planners).
+pub(crate) fn parse_planner(text: &str) -> Result<String, String> {
+    let registry = sim::BehaviourRegistry::builtin();
+    if registry.contains(text) {
+        Ok(text.to_string())
+    } else {
+        Err(mergesim::experiment::unknown_planner(&registry, text))
+    }
 }
 
 pub(crate) fn parse_traffic_mode(text: &str) -> Result<sim::recorded_traffic::TrafficMode, String> {
@@ -327,7 +333,7 @@ pub(crate) struct SweepArgs {
     pub(crate) source: ScenarioArgs,
     /// Planner of every planner-driven vehicle (overrides the scenario's choice).
     #[arg(long, value_name = "PLANNER", value_parser = parse_planner, conflicts_with = "planners")]
-    pub(crate) planner: Option<PlannerKind>,
+    pub(crate) planner: Option<String>,
     /// Paired sweep: run every instance with each of these planners (comma-separated; same
     /// seed, same drawn values) and report each planner's aggregate and the paired differences
     /// of each planner against the FIRST (the baseline): mean ± standard error of (planner −
@@ -335,7 +341,7 @@ pub(crate) struct SweepArgs {
     /// misses, min gap, min TTC, peak yaw rate, peak sideslip, min speed and each vehicle's
     /// figures and the paper's. One name is the same as --planner.
     #[arg(long, value_name = "P1,P2,...", value_delimiter = ',', value_parser = parse_planner)]
-    pub(crate) planners: Vec<PlannerKind>,
+    pub(crate) planners: Vec<String>,
     /// Number of randomised instances in the whole sweep (1 to 1000000); each runs once per
     /// planner.
     #[arg(long, value_name = "N", value_parser = parse_runs)]
@@ -417,7 +423,7 @@ pub(crate) struct GridArgs {
     /// Planners, comma-separated; the first is the reference of the paired differences.
     #[arg(long, value_delimiter = ',', value_parser = parse_planner,
           default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
-    pub(crate) planners: Vec<PlannerKind>,
+    pub(crate) planners: Vec<String>,
     /// Path-field time gaps τ (s), comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "0,1,2,3", value_parser = parse_gap)]
     pub(crate) path_gaps: Vec<f64>,

@@ -87,7 +87,7 @@ fn default_rrd(scenario: &Scenario, label: &str, duration_s: Option<f64>) -> Pat
 
 pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failure> {
     let scenario = load_source(&args.source)?;
-    let label = mergesim::sweep::planner_label(&scenario, args.planner);
+    let label = mergesim::sweep::planner_label(&scenario, args.planner.as_deref());
     if !cfg!(feature = "rerun") && (args.rrd.is_some() || args.view) {
         return Err(crate::input(anyhow::anyhow!(
             "{}",
@@ -158,7 +158,7 @@ pub(crate) fn cmd_run(args: &RunArgs, interrupt: &Interrupt) -> Result<(), Failu
     }
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let what = Simulation {
-        planner: args.planner,
+        planner: args.planner.as_deref(),
         seed,
         rrd: rrd.as_deref(),
         keep_time_series: args.csv.is_some() || args.gif.is_some(),
@@ -332,9 +332,9 @@ pub(crate) fn cmd_compare(args: &CompareArgs, interrupt: &Interrupt) -> Result<(
     let mut summaries = Vec::new();
     let mut time_series = Vec::new();
     let mut collisions = Vec::new();
-    for &kind in &args.planners {
+    for name in &args.planners {
         let what = Simulation {
-            planner: Some(kind),
+            planner: Some(name.as_str()),
             seed: args.seed,
             keep_time_series: args.plots.is_some(),
             show_progress,
@@ -502,6 +502,7 @@ pub(crate) fn cmd_grid(args: &GridArgs, interrupt: &Interrupt) -> Result<(), Fai
         axes,
         scenario,
         planners: args.planners.clone(),
+        registry: std::sync::Arc::new(sim::BehaviourRegistry::builtin()),
         runs: args.runs,
         seed: args.seed,
         threads: args.threads,

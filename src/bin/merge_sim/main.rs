@@ -23,7 +23,7 @@ use anyhow::Context;
 use clap::Parser;
 use mergesim::experiment::{Finished, InstanceOptions, RunError, planner_label, run_instance};
 use mergesim::output::write_atomically;
-use planner::{ParameterSet, PlannerKind};
+use planner::ParameterSet;
 use scenarios::Scenario;
 use sim::BehaviourRegistry;
 use sim::recording::{Recorder, RecorderParams};
@@ -172,8 +172,8 @@ fn progress_printer(enabled: bool, label: String) -> impl FnMut(f64) {
 /// What one `simulate` call runs and keeps.
 #[derive(Default)]
 pub(crate) struct Simulation<'a> {
-    /// Planner override.
-    pub(crate) planner: Option<PlannerKind>,
+    /// Planner override (a registered name).
+    pub(crate) planner: Option<&'a str>,
     /// Instance seed (None: the nominal scenario).
     pub(crate) seed: Option<u64>,
     /// Recording path.
@@ -210,8 +210,7 @@ pub(crate) fn simulate(
         follow,
         lane_ids,
     } = *what;
-    let planner = planner.map(|k| k.name().to_string());
-    let label = planner_label(scenario, planner.as_deref());
+    let label = planner_label(scenario, planner);
     let recorder = match rrd {
         Some(path) => Recorder::new_file_with_params(
             path,
@@ -228,7 +227,7 @@ pub(crate) fn simulate(
         None => Recorder::disabled(),
     };
     let options = InstanceOptions {
-        planner,
+        planner: planner.map(str::to_string),
         seed,
         keep_time_series,
         interrupt: Some(interrupt.flag.clone()),

@@ -108,6 +108,7 @@ pub(crate) fn cmd_study(args: &StudyArgs, interrupt: &Interrupt) -> Result<(), F
         shard: Some(shard),
         interrupt: Some(interrupt.flag.clone()),
         resume,
+        ..RunOptions::default()
     };
     // Every check done: the folder and the rows file.
     create_out(&out).map_err(input)?;

@@ -54,8 +54,8 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
         }
     };
     // `--planner P` and `--planners P` are the same sweep.
-    let planners = match args.planner {
-        Some(kind) => vec![kind],
+    let planners = match &args.planner {
+        Some(name) => vec![name.clone()],
         None => args.planners.clone(),
     };
     let plan = PairedSweepPlan {
@@ -110,6 +110,7 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
         threads: args.threads,
         interrupt: Some(interrupt.flag.clone()),
         resume,
+        ..SweepOptions::default()
     };
     // Every check before any work or any write.
     validate_paired(&plan, &options).map_err(sweep_failure)?;
