@@ -27,9 +27,10 @@
 //! Cholesky solve) already satisfies the bounds it *is* the QP optimum and Clarabel is skipped.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
+use clarabel::solver::NonnegativeConeT;
 use nalgebra::{Matrix4, Vector4};
 
+use crate::clarabel_setup::{ProgramSettings, new_solver, solve_checked};
 use crate::error::PlannerError;
 use crate::params::PlannerParams;
 
@@ -132,35 +133,13 @@ pub fn solve_box_qp(
     let mut b = bounds.upper.to_vec();
     b.extend(bounds.lower.iter().map(|v| -v));
     let cones = [NonnegativeConeT(8)];
-    let settings = DefaultSettings {
-        verbose: false,
-        max_iter: max_iterations,
-        tol_gap_abs: tolerance,
-        tol_gap_rel: tolerance,
-        tol_feas: tolerance,
-        presolve_enable: false,
-        ..DefaultSettings::default()
+    let settings = ProgramSettings {
+        max_iterations,
+        tolerance,
+        scaling_and_refinement: true,
     };
-    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).map_err(|e| {
-        PlannerError::SolverFailed {
-            problem: "cubic_fit".into(),
-            status: e.to_string(),
-        }
-    })?;
-    solver.solve();
-    let status = solver.solution.status;
-    if !matches!(status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
-        return Err(PlannerError::SolverFailed {
-            problem: "cubic_fit".into(),
-            status: format!("{status:?}"),
-        });
-    }
-    let x = &solver.solution.x;
-    if x.len() != 4 || x.iter().any(|v| !v.is_finite()) {
-        return Err(PlannerError::NonFinite {
-            what: "cubic_fit solution".into(),
-        });
-    }
+    let mut solver = new_solver("cubic_fit", &p, &q, &a, &b, &cones, &settings)?;
+    let x = solve_checked(&mut solver, "cubic_fit", 4)?;
     // Interior-point iterates sit a hair inside or outside the box: snap to it.
     Ok([0, 1, 2, 3].map(|k| x[k].clamp(bounds.lower[k], bounds.upper[k])))
 }

@@ -8,6 +8,7 @@
 
 pub mod attractive_field;
 pub mod behaviour;
+mod clarabel_setup;
 pub mod cubic_fit;
 pub mod error;
 pub mod fallback;

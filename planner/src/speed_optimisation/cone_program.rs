@@ -23,13 +23,11 @@
 //! `update_q` / `update_b`.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettings, DefaultSolver, IPSolver, NonnegativeConeT, SecondOrderConeT, SolverStatus,
-    SupportedConeT,
-};
+use clarabel::solver::{DefaultSolver, NonnegativeConeT, SecondOrderConeT, SupportedConeT};
 
 use super::SpeedProblem;
 use super::scp::SpeedOptimiser;
+use crate::clarabel_setup::{ProgramSettings, new_solver, solve_checked, solver_failed};
 use crate::error::PlannerError;
 use crate::params::PlannerParams;
 
@@ -165,28 +163,16 @@ pub(super) struct CachedSolver {
     solver: DefaultSolver<f64>,
 }
 
-/// Clarabel's settings for both programs of the speed optimisation.
-pub(super) fn solver_settings(params: &PlannerParams) -> DefaultSettings<f64> {
-    DefaultSettings {
-        verbose: false,
-        max_iter: params.solver_max_iterations,
-        tol_gap_abs: params.solver_tolerance,
-        tol_gap_rel: params.solver_tolerance,
-        tol_feas: params.solver_tolerance,
-        presolve_enable: false,
-        // The problems are small and well scaled (A entries ±1, ±2; P diagonal; speeds of
-        // order 10): equilibration and iterative refinement cost about half the solve time
-        // here without changing the answer (closed-form test at 1e-5).
-        equilibrate_enable: false,
-        iterative_refinement_enable: false,
-        ..DefaultSettings::default()
-    }
-}
+/// The name of both programs of the speed optimisation in errors.
+pub(super) const PROBLEM: &str = "speed_optimisation";
 
-pub(super) fn solver_failed(status: impl Into<String>) -> PlannerError {
-    PlannerError::SolverFailed {
-        problem: "speed_optimisation".into(),
-        status: status.into(),
+/// Clarabel's settings for both programs of the speed optimisation: without equilibration and
+/// iterative refinement (`ProgramSettings::scaling_and_refinement`).
+pub(super) fn solver_settings(params: &PlannerParams) -> ProgramSettings {
+    ProgramSettings {
+        max_iterations: params.solver_max_iterations,
+        tolerance: params.solver_tolerance,
+        scaling_and_refinement: false,
     }
 }
 
@@ -243,16 +229,15 @@ impl SpeedOptimiser {
                 .as_mut()
                 .is_some_and(|c| c.solver.update_q(&q).is_ok() && c.solver.update_b(&b).is_ok());
         if !updated {
-            let settings = solver_settings(params);
-            let solver = DefaultSolver::new(
+            let solver = new_solver(
+                PROBLEM,
                 &layout.p_matrix(params.speed_deviation_weight),
                 &q,
                 &layout.a_matrix(),
                 &b,
                 &layout.cones(),
-                settings,
-            )
-            .map_err(|e| solver_failed(e.to_string()))?;
+                &solver_settings(params),
+            )?;
             self.cached = Some(CachedSolver {
                 layout,
                 w2_bits,
@@ -262,19 +247,9 @@ impl SpeedOptimiser {
             });
         }
         let Some(cached) = self.cached.as_mut() else {
-            return Err(solver_failed("no solver"));
+            return Err(solver_failed(PROBLEM, "no solver"));
         };
-        cached.solver.solve();
-        let status = cached.solver.solution.status;
-        if !matches!(status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
-            return Err(solver_failed(format!("{status:?}")));
-        }
-        let x = &cached.solver.solution.x;
-        if x.len() != 2 * n || x.iter().any(|v| !v.is_finite()) {
-            return Err(PlannerError::NonFinite {
-                what: "speed_optimisation solution".into(),
-            });
-        }
+        let x = solve_checked(&mut cached.solver, PROBLEM, 2 * n)?;
         // Snap interior-point round-off onto the box.
         Ok((0..n)
             .map(|i| x[i].clamp(lo[i], hi[i].max(lo[i])))

@@ -26,11 +26,12 @@
 //! `update_q` and `update_b`.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus, SupportedConeT};
+use clarabel::solver::{DefaultSolver, NonnegativeConeT, SupportedConeT};
 
 use super::SpeedProblem;
-use super::cone_program::{Layout, solver_failed, solver_settings};
+use super::cone_program::{Layout, PROBLEM, solver_settings};
 use super::scp::SpeedOptimiser;
+use crate::clarabel_setup::{new_solver, solve_checked, solver_failed};
 use crate::error::PlannerError;
 use crate::params::PlannerParams;
 
@@ -117,16 +118,15 @@ impl SpeedOptimiser {
                     && c.solver.update_b(&b).is_ok()
             });
         if !updated {
-            let settings = solver_settings(params);
-            let solver = DefaultSolver::new(
+            let solver = new_solver(
+                PROBLEM,
                 &layout.qp_p_matrix(&h),
                 &q,
                 &layout.qp_a_matrix(),
                 &b,
                 &layout.qp_cones(),
-                settings,
-            )
-            .map_err(|e| solver_failed(e.to_string()))?;
+                &solver_settings(params),
+            )?;
             self.cached_qp = Some(CachedQp {
                 layout,
                 max_iterations: params.solver_max_iterations,
@@ -135,19 +135,9 @@ impl SpeedOptimiser {
             });
         }
         let Some(cached) = self.cached_qp.as_mut() else {
-            return Err(solver_failed("no solver"));
+            return Err(solver_failed(PROBLEM, "no solver"));
         };
-        cached.solver.solve();
-        let status = cached.solver.solution.status;
-        if !matches!(status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
-            return Err(solver_failed(format!("{status:?}")));
-        }
-        let x = &cached.solver.solution.x;
-        if x.len() != n || x.iter().any(|v| !v.is_finite()) {
-            return Err(PlannerError::NonFinite {
-                what: "speed_optimisation solution".into(),
-            });
-        }
+        let x = solve_checked(&mut cached.solver, PROBLEM, n)?;
         // Snap interior-point round-off onto the box.
         Ok((0..n)
             .map(|i| x[i].clamp(lo[i], hi[i].max(lo[i])))
