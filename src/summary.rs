@@ -103,7 +103,7 @@ impl RunSummary {
             planner_stats: outcome.planner_stats.clone(),
             goal_reached: outcome.goals.first().map(|g| g.reached),
             goal_time_s: outcome.goals.first().and_then(|g| g.time_s),
-            events: outcome.events.clone(),
+            events: outcome.events.iter().map(ToString::to_string).collect(),
             profile: outcome.profile.clone(),
         }
     }

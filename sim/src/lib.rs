@@ -8,6 +8,7 @@ pub mod body_state;
 pub mod config;
 pub mod drivers;
 pub mod error;
+pub mod event;
 pub mod goal;
 pub mod idm;
 pub mod lane_membership;
@@ -33,6 +34,7 @@ pub mod world;
 
 pub use config::{Driver, SimConfig, VehicleSpec, validate_vehicles};
 pub use error::SimError;
+pub use event::SimEvent;
 /// Roads made of lanes (what `Observation::lanes` is): re-exported for planners written against
 /// the simulator.
 pub use mergesim_types::lanes;

@@ -10,8 +10,8 @@ use mergesim_types::{Decision, GridSpec, Observation, PathPoint, SharedLocalPath
 use vehicles::Kinematics;
 
 use crate::error::SimError;
+use crate::event::SimEvent;
 use crate::metrics::MetricsSample;
-use crate::recording::EventLevel;
 use crate::safety::BodyState;
 
 /// One vehicle at a logged instant.
@@ -75,8 +75,9 @@ pub trait TickObserver {
         Ok(())
     }
 
-    /// An event (collision, road-edge contact, fallback, lane change, near miss).
-    fn on_event(&mut self, _text: &str, _level: EventLevel) -> Result<(), SimError> {
+    /// An event (collision, road-edge contact, fallback, lane change, near miss, …), typed;
+    /// `Display` gives its event-log line and [`SimEvent::level`] its severity.
+    fn on_event(&mut self, _event: &SimEvent) -> Result<(), SimError> {
         Ok(())
     }
 

@@ -137,8 +137,9 @@ pub struct RunOutcome {
     /// unless requested, or without recorded traffic): what the GIF draws of it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub recorded_track: Vec<RecordedPose>,
-    /// Event log lines (collisions, near misses, fallbacks), in time order.
-    pub events: Vec<String>,
+    /// The run's events (collisions, near misses, fallbacks, …), in time order; `Display`
+    /// gives each one's event-log line.
+    pub events: Vec<crate::event::SimEvent>,
     /// The goals of the vehicles that have one (`crate::goal`), in vehicle order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub goals: Vec<crate::goal::GoalOutcome>,

@@ -3,8 +3,9 @@
 //! planning vehicle's potential field at the field period, and the events.
 
 use crate::error::SimError;
+use crate::event::SimEvent;
 use crate::observer::{PlanView, TickObserver, VehicleView};
-use crate::recording::{EventLevel, Recorder, RecordingError};
+use crate::recording::{Recorder, RecordingError};
 use crate::safety::BodyState;
 use mergesim_types::GridSpec;
 
@@ -161,9 +162,11 @@ impl TickObserver for RecordingObserver {
         Ok(())
     }
 
-    fn on_event(&mut self, text: &str, level: EventLevel) -> Result<(), SimError> {
+    fn on_event(&mut self, event: &SimEvent) -> Result<(), SimError> {
         if let Some(recorder) = self.recorder.as_mut() {
-            recorder.log_event(text, level).map_err(rec)?;
+            recorder
+                .log_event(&event.to_string(), event.level())
+                .map_err(rec)?;
         }
         Ok(())
     }

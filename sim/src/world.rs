@@ -18,11 +18,12 @@ use crate::agent::Agent;
 use crate::config::{SimConfig, VehicleSpec};
 use crate::drivers::lane_path;
 use crate::error::SimError;
+use crate::event::SimEvent;
 use crate::metrics::{MetricsSample, VehicleMetrics};
 use crate::observer::{TickObserver, VehicleView};
 use crate::outcome::{PlannerStats, RunOutcome};
 use crate::profile::{Phase, Profiler};
-use crate::recording::{EventLevel, Recorder};
+use crate::recording::Recorder;
 use crate::recording_observer::RecordingObserver;
 use crate::registry::BehaviourRegistry;
 use crate::run_log::RunLog;
@@ -67,7 +68,7 @@ pub struct World {
     recorded_track: Option<Vec<crate::outcome::RecordedPose>>,
     recording: RecordingObserver,
     observers: Vec<Box<dyn TickObserver>>,
-    events: Vec<String>,
+    events: Vec<SimEvent>,
     plan_times_us: Vec<f64>,
     fallbacks: u64,
     degraded_plans: u64,
@@ -376,10 +377,18 @@ impl World {
     }
 
     /// Records an event in the run's log and tells the observers.
-    fn event(&mut self, text: String, level: EventLevel) -> Result<(), SimError> {
-        self.each_observer(|o| o.on_event(&text, level))?;
-        self.events.push(text);
+    fn event(&mut self, event: SimEvent) -> Result<(), SimError> {
+        self.each_observer(|o| o.on_event(&event))?;
+        self.events.push(event);
         Ok(())
+    }
+
+    /// The name of vehicle `id` (simulated or recorded), or `vehicle ID`.
+    fn name_of(names: &[String], id: VehicleId) -> String {
+        names
+            .get(id as usize)
+            .cloned()
+            .unwrap_or_else(|| format!("vehicle {id}"))
     }
 
     /// The vehicles' chassis boxes as the safety checks and the recording see them: the
@@ -424,10 +433,15 @@ impl World {
                 .map(|a| a.id)
                 .filter(|id| event.involves(*id))
                 .collect();
-            self.event(event.describe(&names), EventLevel::Error)?;
+            let caused_by_replay = event.caused_by_replay;
+            self.event(SimEvent::Collision {
+                vehicle_a: Self::name_of(&names, event.id_a),
+                vehicle_b: Self::name_of(&names, event.id_b),
+                event,
+            })?;
             // A collision caused by the replay is not the simulated vehicle's (module doc of
             // the safety monitor's `recorded_pairs`): its metrics do not count it.
-            if !event.caused_by_replay {
+            if !caused_by_replay {
                 self.each_observer(|o| {
                     o.on_collision(&ids);
                     Ok(())
@@ -437,12 +451,12 @@ impl World {
         }
         while self.reported_edge_contacts < self.safety.edge_contact_events().len() {
             let event = self.safety.edge_contact_events()[self.reported_edge_contacts].clone();
-            let name = names.get(event.id as usize).cloned().unwrap_or_default();
-            let text = format!(
-                "t = {:.3} s: vehicle {name} hit the {:?} road edge",
-                event.t_s, event.edge
-            );
-            self.event(text, EventLevel::Error)?;
+            let vehicle = names.get(event.id as usize).cloned().unwrap_or_default();
+            self.event(SimEvent::EdgeContact {
+                t_s: event.t_s,
+                vehicle,
+                edge: event.edge,
+            })?;
             self.each_observer(|o| {
                 o.on_collision(&[event.id]);
                 Ok(())
@@ -484,7 +498,15 @@ impl World {
         if !handovers.is_empty() {
             let names = self.names();
             for handover in handovers {
-                self.event(handover.describe(&names), EventLevel::Info)?;
+                self.event(SimEvent::RecordedHandover {
+                    t_s: handover.t_s,
+                    leader: Self::name_of(&names, handover.leader),
+                    vehicle: handover.name,
+                    gap_m: handover.gap_m,
+                    safe_gap_m: handover.safe_gap_m,
+                    speed_mps: handover.speed_mps,
+                    approach_rate_mps: handover.approach_rate_mps,
+                })?;
             }
         }
         Ok(())

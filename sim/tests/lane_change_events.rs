@@ -91,7 +91,10 @@ fn events_of(config: SimConfig, x_m: f64) -> (Vec<String>, u32) {
         .paper_metrics
         .as_ref()
         .map_or(0, |p| p.divider_crossings);
-    (outcome.events, crossings)
+    (
+        outcome.events.iter().map(ToString::to_string).collect(),
+        crossings,
+    )
 }
 
 fn assert_down_and_back(events: &[String], crossings: u32, what: &str) {

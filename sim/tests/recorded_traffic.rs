@@ -302,12 +302,10 @@ fn replay_running_into_a_simulated_car_from_behind_is_counted_apart() {
     // Not the ego's collision: its metrics do not count it.
     assert_eq!(outcome.vehicles.len(), 1);
     assert!(!outcome.vehicles[0].collided);
-    assert!(
-        outcome
-            .events
-            .iter()
-            .any(|e| e.contains("caused by the replay"))
-    );
+    assert!(outcome.events.iter().any(
+        |e| matches!(e, sim::SimEvent::Collision { event, .. } if event.caused_by_replay)
+            && e.to_string().contains("caused by the replay")
+    ));
 }
 
 #[test]
@@ -317,10 +315,11 @@ fn reactive_hands_over_to_idm_when_the_gap_criterion_says_and_does_not_collide()
     assert_eq!(idm, IdmParams::default());
     let outcome = run(config, &specs);
     assert!(outcome.safety.collisions.is_empty(), "{:?}", outcome.events);
-    let handovers: Vec<&String> = outcome
+    let handovers: Vec<String> = outcome
         .events
         .iter()
-        .filter(|e| e.contains("hands over to IDM"))
+        .filter(|e| matches!(e, sim::SimEvent::RecordedHandover { .. }))
+        .map(ToString::to_string)
         .collect();
     assert_eq!(handovers.len(), 1, "{:?}", outcome.events);
     // By hand: v = 15 m/s, Δv = 5 m/s, s* = 2 + 15 · 1.6 + 15 · 5 / (2 √(0.73 · 1.67))
@@ -331,7 +330,8 @@ fn reactive_hands_over_to_idm_when_the_gap_criterion_says_and_does_not_collide()
     assert!((safe_gap_m - 59.96).abs() < 0.01, "{safe_gap_m}");
     assert!((desired_gap_m(&idm, 15.0, 5.0) - safe_gap_m).abs() < 1e-12);
     let t_expected_s = (95.5 - safe_gap_m) / 5.0 - 0.002;
-    let text = handovers[0];
+    let text = &handovers[0];
+    assert!(text.contains("hands over to IDM"), "{text}");
     let number_after = |key: &str| -> f64 {
         let rest = &text[text.find(key).unwrap_or_else(|| panic!("{key} in {text}")) + key.len()..];
         let end = rest.find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'));

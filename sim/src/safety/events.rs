@@ -42,32 +42,6 @@ impl CollisionEvent {
     pub fn involves(&self, id: VehicleId) -> bool {
         self.id_a == id || self.id_b == id
     }
-
-    /// One line for logs; `names[id]` names vehicle `id` (falls back to the id).
-    pub fn describe(&self, names: &[String]) -> String {
-        let name = |id: VehicleId| {
-            names
-                .get(id as usize)
-                .cloned()
-                .unwrap_or_else(|| format!("vehicle {id}"))
-        };
-        let contact = self
-            .t_contact_estimate_s
-            .map(|t| format!(", first contact at {t:.3} s"))
-            .unwrap_or_default();
-        let cause = if self.caused_by_replay {
-            " (a recorded vehicle ran into a simulated one from behind: caused by the replay)"
-        } else {
-            ""
-        };
-        format!(
-            "collision {} / {} at t = {:.3} s{contact}, relative speed {:.2} m/s{cause}",
-            name(self.id_a),
-            name(self.id_b),
-            self.t_s,
-            self.relative_speed_mps
-        )
-    }
 }
 
 /// Start of an episode of a vehicle touching or crossing a road edge.

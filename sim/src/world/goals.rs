@@ -5,8 +5,8 @@ use vehicles::Kinematics;
 
 use super::World;
 use crate::error::SimError;
+use crate::event::SimEvent;
 use crate::goal::{GoalCheck, GoalOutcome};
-use crate::recording::EventLevel;
 
 impl World {
     /// Checks the goal of every vehicle that has one and has not reached it yet; logs the
@@ -33,10 +33,13 @@ impl World {
             };
             if goal.is_reached(&at, &self.lanes) {
                 reached_at.push(i);
-                reached.push(format!(
-                    "t = {t_s:.2} s: {} reached its goal at x = {:.1} m, y = {:.1} m, {:.2} m/s",
-                    agent.spec.name, k.x_m, k.y_m, k.speed_mps
-                ));
+                reached.push(SimEvent::GoalReached {
+                    t_s,
+                    vehicle: agent.spec.name.clone(),
+                    x_m: k.x_m,
+                    y_m: k.y_m,
+                    speed_mps: k.speed_mps,
+                });
             }
         }
         for i in reached_at {
@@ -44,8 +47,8 @@ impl World {
                 *slot = Some(t_s);
             }
         }
-        for text in reached {
-            self.event(text, EventLevel::Info)?;
+        for event in reached {
+            self.event(event)?;
         }
         Ok(())
     }
@@ -73,12 +76,10 @@ impl World {
         lane: mergesim_types::lanes::LaneId,
     ) -> Result<(), SimError> {
         self.left_map = true;
-        self.event(
-            format!(
-                "t = {t_s:.2} s: {vehicle} left the map (its front passed the open end of lane \
-                 {lane}); the run ends here"
-            ),
-            EventLevel::Warn,
-        )
+        self.event(SimEvent::LeftMap {
+            t_s,
+            vehicle: vehicle.to_string(),
+            lane,
+        })
     }
 }

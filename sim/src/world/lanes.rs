@@ -7,8 +7,8 @@ use mergesim_types::lanes::{LaneId, LaneRoad};
 
 use super::World;
 use crate::error::SimError;
+use crate::event::SimEvent;
 use crate::lane_membership::{lane_change, lane_of};
-use crate::recording::EventLevel;
 
 impl World {
     /// Updates every vehicle's lane (`crate::lane_membership`) and logs each lane change, in
@@ -22,16 +22,20 @@ impl World {
         for (agent, k) in self.agents.iter_mut().zip(kins) {
             let hit = lane_of(&self.lanes, Some(agent.lane), [k.x_m, k.y_m]);
             if let Some(direction) = lane_change(&self.lanes, agent.lane, hit.lane) {
-                changes.push(format!(
-                    "t = {t_s:.2} s: {} changed lanes {direction}, from lane {} to lane {}, at \
-                     x = {:.1} m, y = {:.1} m",
-                    agent.spec.name, agent.lane, hit.lane, k.x_m, k.y_m
-                ));
+                changes.push(SimEvent::LaneChange {
+                    t_s,
+                    vehicle: agent.spec.name.clone(),
+                    direction: direction.to_string(),
+                    from_lane: agent.lane,
+                    to_lane: hit.lane,
+                    x_m: k.x_m,
+                    y_m: k.y_m,
+                });
             }
             agent.lane = hit.lane;
         }
-        for text in changes {
-            self.event(text, EventLevel::Info)?;
+        for event in changes {
+            self.event(event)?;
         }
         Ok(())
     }

@@ -96,18 +96,10 @@ impl World {
     pub(super) fn finish(mut self) -> Result<RunOutcome, SimError> {
         let safety = self.safety.summary();
         if safety.near_miss {
-            let text = format!(
-                "near miss: min gap {} m, min TTC {}",
-                safety
-                    .min_gap_m
-                    .map(|g| format!("{g:.2}"))
-                    .unwrap_or_else(|| "-".into()),
-                safety
-                    .min_ttc_s
-                    .map(|t| format!("{t:.2} s"))
-                    .unwrap_or_else(|| "none".into())
-            );
-            self.event(text, EventLevel::Warn)?;
+            self.event(SimEvent::NearMiss {
+                min_gap_m: safety.min_gap_m,
+                min_ttc_s: safety.min_ttc_s,
+            })?;
         }
         let mut times = self.plan_times_us.clone();
         times.sort_by(f64::total_cmp);

@@ -20,9 +20,9 @@ use rayon::prelude::*;
 use super::{World, check_finite};
 use crate::agent::Agent;
 use crate::error::SimError;
+use crate::event::SimEvent;
 use crate::observer::{PlanView, TickObserver};
 use crate::profile::Phase;
-use crate::recording::EventLevel;
 use crate::spatial::neighbours_within;
 
 impl World {
@@ -145,24 +145,32 @@ impl World {
                     self.degraded_plans += 1;
                 }
                 if decision.degraded_mode != self.agents[index].degraded_mode {
-                    let text = match (&decision.degraded_mode, &self.agents[index].degraded_mode) {
-                        (Some(mode), _) => {
-                            format!("t = {t_s:.2} s: {name} plans in degraded mode {mode}")
-                        }
-                        (None, Some(mode)) => {
-                            format!("t = {t_s:.2} s: {name} left degraded mode {mode}")
-                        }
-                        (None, None) => String::new(),
+                    let event = match (&decision.degraded_mode, &self.agents[index].degraded_mode) {
+                        (Some(mode), _) => Some(SimEvent::DegradedModeEntered {
+                            t_s,
+                            vehicle: name.clone(),
+                            mode: mode.clone(),
+                        }),
+                        (None, Some(mode)) => Some(SimEvent::DegradedModeLeft {
+                            t_s,
+                            vehicle: name.clone(),
+                            mode: mode.clone(),
+                        }),
+                        // Unequal modes are never both absent.
+                        (None, None) => None,
                     };
                     self.agents[index].degraded_mode = decision.degraded_mode.clone();
-                    self.event(text, EventLevel::Warn)?;
+                    if let Some(event) = event {
+                        self.event(event)?;
+                    }
                 }
                 if let Some(reason) = &decision.fallback {
                     self.fallbacks += 1;
-                    self.event(
-                        format!("t = {t_s:.2} s: planner fallback of {name}: {reason}"),
-                        EventLevel::Warn,
-                    )?;
+                    self.event(SimEvent::PlannerFallback {
+                        t_s,
+                        vehicle: name.clone(),
+                        reason: reason.clone(),
+                    })?;
                 }
                 let behaviour = &self.agents[index].behaviour;
                 let field = |spec: &GridSpec| behaviour.potential_field(&observation, spec);

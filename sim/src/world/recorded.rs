@@ -98,27 +98,6 @@ pub struct Handover {
     pub approach_rate_mps: f64,
 }
 
-impl Handover {
-    /// The event line; `names[id]` names vehicle `id`.
-    pub fn describe(&self, names: &[String]) -> String {
-        let leader = names
-            .get(self.leader as usize)
-            .cloned()
-            .unwrap_or_else(|| format!("vehicle {}", self.leader));
-        format!(
-            "t = {:.3} s: recorded vehicle {} hands over to IDM behind {}: its recording would \
-             leave a gap of {:.3} m < s* = {:.3} m (v = {:.2} m/s, Δv = {:.2} m/s)",
-            self.t_s,
-            self.name,
-            leader,
-            self.gap_m,
-            self.safe_gap_m,
-            self.speed_mps,
-            self.approach_rate_mps
-        )
-    }
-}
-
 /// The recorded vehicles of a world (module doc).
 pub(crate) struct RecordedFleet {
     mode: TrafficMode,
