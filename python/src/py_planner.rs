@@ -66,8 +66,9 @@ pub fn register_planner(name: &str, factory: Bound<'_, PyAny>) -> PyResult<()> {
     // The registry's own checks (name syntax, taken), with the built-ins, the environment's
     // `external` and the Python planners already there.
     let mut taken = BehaviourRegistry::builtin();
-    let dummy: sim::registry::BehaviourFactory =
-        Arc::new(|input: &FactoryInput<'_>| Err(SimError::InvalidScenario(input.spec.name.clone())));
+    let dummy: sim::registry::BehaviourFactory = Arc::new(|input: &FactoryInput<'_>| {
+        Err(SimError::InvalidScenario(input.spec.name.clone()))
+    });
     for existing in table.keys().map(String::as_str).chain([EXTERNAL_PLANNER]) {
         taken
             .register(existing, dummy.clone())
@@ -282,9 +283,10 @@ fn path_point(value: &Bound<'_, PyAny>, index: usize) -> Result<PathPoint, Strin
             )
         })?
     };
-    for (value, key) in [x_m, y_m, speed_mps, t_s]
-        .into_iter()
-        .zip(["x_m", "y_m", "speed_mps", "t_s"])
+    for (value, key) in
+        [x_m, y_m, speed_mps, t_s]
+            .into_iter()
+            .zip(["x_m", "y_m", "speed_mps", "t_s"])
     {
         if !value.is_finite() {
             return Err(format!("path[{index}].{key} = {value}: not finite"));

@@ -81,8 +81,8 @@ impl Road {
         d_m: f64,
     ) -> PyResult<Vec<(f64, f64)>> {
         let lane = self.lane(lane)?;
-        if !(step_m.is_finite() && step_m > 0.0) || !s_from_m.is_finite() || !s_to_m.is_finite()
-        {
+        let finite = s_from_m.is_finite() && s_to_m.is_finite() && step_m.is_finite();
+        if !finite || step_m <= 0.0 {
             return Err(BindingError::Input(format!(
                 "centreline: need finite s_from_m, s_to_m and step_m > 0, got {s_from_m}, \
                  {s_to_m}, {step_m}"

@@ -21,16 +21,15 @@ pub fn run(
     seed: Option<u64>,
 ) -> PyResult<(String, String)> {
     let scenario = source::load(scenario, params_json)?;
-    // Checked as `merge_sim run --planner` checks it (the same message).
-    // The built-in planners and the Python ones registered now.
+    // The built-in planners and the Python ones registered now; the name checked as
+    // `merge_sim run --planner` checks it (the same message).
     let registry = crate::py_planner::registry()?;
-    if let Some(name) = planner {
-        if !registry.contains(name) {
-            return Err(BindingError::Input(mergesim::experiment::unknown_planner(
-                &registry, name,
-            ))
-            .into());
-        }
+    if let Some(name) = planner
+        && !registry.contains(name)
+    {
+        return Err(
+            BindingError::Input(mergesim::experiment::unknown_planner(&registry, name)).into(),
+        );
     }
     let planner = planner.map(str::to_string);
     let finished = run_interruptible(py, None, |interrupt| {
