@@ -9,14 +9,18 @@
 - :class:`MergeEnv` — a Gymnasium environment: the agent drives one vehicle through the
   simulator's tracker, the others run the scenario's planners (also registered as
   ``mergesim/Merge-v0``);
+- :func:`register_planner` — a planner written in Python (``plan(observation) -> decision``)
+  under a name, usable wherever a planner name goes (``run``, ``sweep``, ``study``,
+  ``MergeEnv``);
 - :class:`ScenarioError` (a ``ValueError``) for bad input, with ``merge_sim``'s message;
   :class:`SimulationError` (a ``RuntimeError``) for a failure while simulating.
 
 See python/README.md.
 """
 
-from ._native import ScenarioError, SimulationError, builtin_scenarios, planners
+from ._native import Road, ScenarioError, SimulationError, builtin_scenarios, planners
 from .env import MergeEnv, RewardWeights
+from .planner import Planner, python_planners, register_planner, unregister_planner
 from .run import RunResult, run
 from .study import study
 from .sweep import never_as_infinity, never_column, paired_differences, rows_frame, sweep
@@ -31,7 +35,9 @@ except Exception:  # not installed (e.g. imported from the source tree)
 __all__ = [
     "__version__",
     "MergeEnv",
+    "Planner",
     "RewardWeights",
+    "Road",
     "RunResult",
     "ScenarioError",
     "SimulationError",
@@ -40,10 +46,13 @@ __all__ = [
     "never_column",
     "paired_differences",
     "planners",
+    "python_planners",
+    "register_planner",
     "rows_frame",
     "run",
     "study",
     "sweep",
+    "unregister_planner",
 ]
 
 

@@ -1,6 +1,6 @@
 """Type stubs of the native module (Rust, PyO3). Use the wrappers in ``mergesim`` instead."""
 
-from typing import List, Optional, Sequence, Tuple
+from typing import Any, Callable, List, Optional, Sequence, Tuple
 
 class ScenarioError(ValueError):
     """Bad input: what ``merge_sim`` rejects with exit code 2 (the message is the CLI's)."""
@@ -43,7 +43,40 @@ def builtin_scenarios() -> List[str]:
     """Names of the built-in scenarios."""
 
 def planners() -> List[str]:
-    """Names of the built-in planners."""
+    """Names of the registered planners (the built-in ones and the Python ones), sorted."""
+
+def register_planner(name: str, factory: Callable[[], Any]) -> None:
+    """Registers a Python planner factory under ``name``; ScenarioError for a bad or taken name."""
+
+def unregister_planner(name: str) -> None:
+    """Removes the Python planner ``name``; ScenarioError if there is none."""
+
+def python_planners() -> List[str]:
+    """Names of the registered Python planners, sorted."""
+
+class Road:
+    """The road of a run as lanes (``observation["road"]`` of a Python planner). s: arc length
+    along a lane's centreline (m); d: lateral offset from it (m, positive to the left)."""
+
+    def lane_ids(self) -> List[int]: ...
+    def nearest_lane(self, x_m: float, y_m: float) -> Tuple[int, float, float]:
+        """(lane id, s_m, d_m) of the point in its nearest lane."""
+    def project(self, lane: int, x_m: float, y_m: float) -> Tuple[float, float]:
+        """(s_m, d_m) of the point in lane ``lane``'s frame."""
+    def point(self, lane: int, s_m: float, d_m: float = 0.0) -> Tuple[float, float]:
+        """(x_m, y_m) at (s_m, d_m) of lane ``lane``'s frame."""
+    def centreline(
+        self, lane: int, s_from_m: float, s_to_m: float, step_m: float, d_m: float = 0.0
+    ) -> List[Tuple[float, float]]:
+        """Points of lane ``lane`` at offset ``d_m``, every ``step_m`` from ``s_from_m`` to ``s_to_m``."""
+    def heading_rad(self, lane: int, s_m: float) -> float: ...
+    def width_m(self, lane: int, s_m: float) -> float: ...
+    def length_m(self, lane: int) -> float: ...
+    def neighbours(self, lane: int) -> Tuple[Optional[int], Optional[int]]:
+        """(left lane id or None, right lane id or None)."""
+    def successors(self, lane: int) -> List[int]: ...
+    def distance_to_closed_end_m(self, lane: int, s_m: float) -> Optional[float]:
+        """How far ahead the lane must be left (every way on ends closed); None if it goes on."""
 
 StepResult = Tuple[List[List[float]], bool, bool, Optional[str], Optional[str], float]
 

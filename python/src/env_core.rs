@@ -59,6 +59,22 @@ impl TickObserver for ContactWatch {
     }
 }
 
+/// The world, handed to `Python::detach`'s closure, which runs on this same thread (it only
+/// releases the GIL): a `World` is not `Send` (its observers need not be), and nothing in it
+/// borrows from the GIL (a Python planner holds `Py` handles, which are `Send`).
+struct OnThisThread<'a>(&'a mut World);
+
+// SAFETY: `Python::detach` runs its closure on the calling thread, so the world never changes
+// threads; the bound only keeps GIL-bound references (`Bound`, `Python`) out of the closure,
+// and a `World` holds none.
+unsafe impl Send for OnThisThread<'_> {}
+
+impl<'a> OnThisThread<'a> {
+    fn into_inner(self) -> &'a mut World {
+        self.0
+    }
+}
+
 /// What one environment step did (returned to Python as a tuple).
 type StepResult = (
     Vec<Vec<f64>>,
@@ -140,7 +156,8 @@ impl EnvCore {
             })?,
             None => names.iter().position(|n| *n == "ego").unwrap_or(0),
         };
-        let registry = BehaviourRegistry::builtin();
+        // The built-in planners and the Python ones registered now.
+        let registry = crate::py_planner::registry()?;
         // Checked as `merge_sim run --planner` checks it (the same message).
         if let Some(name) = &planner
             && !registry.contains(name)
@@ -239,7 +256,12 @@ impl EnvCore {
     /// y) and advances one planning period. Returns (states, collided with a vehicle, hit a
     /// road edge, the vehicle whose front passed the road's end, a simulation error, time s);
     /// after either of the last two the episode is over.
-    fn step(&mut self, target_speed_mps: f64, target_y_m: f64) -> PyResult<StepResult> {
+    fn step(
+        &mut self,
+        py: Python<'_>,
+        target_speed_mps: f64,
+        target_y_m: f64,
+    ) -> PyResult<StepResult> {
         let Some(world) = self.world.as_mut() else {
             return Err(BindingError::Input("step before reset: call reset() first".into()).into());
         };
@@ -256,20 +278,21 @@ impl EnvCore {
             target_speed_mps: target_speed_mps.max(0.0),
             target_y_m,
         };
-        let (mut road_end, mut error) = (None, None);
-        for _ in 0..world.steps_per_plan() {
-            match world.step() {
-                Ok(()) => {}
-                Err(SimError::RoadEnd { vehicle, .. }) => {
-                    road_end = Some(vehicle);
-                    break;
-                }
-                Err(e) => {
-                    error = Some(crate::errors::chain(&e));
-                    break;
+        // Without the GIL: the world plans on a pool thread, where a Python planner (a
+        // neighbour's) takes the GIL for each of its cycles.
+        let stepping = OnThisThread(world);
+        let (road_end, error) = py.detach(move || {
+            // A method call, so the closure captures the wrapper, not its field.
+            let world = stepping.into_inner();
+            for _ in 0..world.steps_per_plan() {
+                match world.step() {
+                    Ok(()) => {}
+                    Err(SimError::RoadEnd { vehicle, .. }) => return (Some(vehicle), None),
+                    Err(e) => return (None, Some(crate::errors::chain(&e))),
                 }
             }
-        }
+            (None, None)
+        });
         let states = Self::states(world);
         let time_s = world.time_s();
         if road_end.is_some() || error.is_some() {

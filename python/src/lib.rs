@@ -6,6 +6,8 @@ mod background;
 mod env_core;
 mod errors;
 mod external;
+mod py_planner;
+mod road;
 mod run;
 mod source;
 mod study;
@@ -26,7 +28,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(planners, m)?)?;
     m.add_function(wrap_pyfunction!(instance_seed, m)?)?;
     m.add_function(wrap_pyfunction!(parse_seed, m)?)?;
+    m.add_function(wrap_pyfunction!(py_planner::register_planner, m)?)?;
+    m.add_function(wrap_pyfunction!(py_planner::unregister_planner, m)?)?;
+    m.add_function(wrap_pyfunction!(py_planner::python_planners, m)?)?;
     m.add_class::<env_core::EnvCore>()?;
+    m.add_class::<road::Road>()?;
     Ok(())
 }
 
@@ -36,10 +42,14 @@ fn builtin_scenarios() -> Vec<&'static str> {
     scenarios::builtin::names()
 }
 
-/// Names of the built-in planners.
+/// Names of the registered planners (the built-in ones and the Python ones), sorted.
 #[pyfunction]
-fn planners() -> Vec<&'static str> {
-    planner::PlannerKind::ALL.iter().map(|k| k.name()).collect()
+fn planners() -> PyResult<Vec<String>> {
+    Ok(py_planner::registry()?
+        .names()
+        .into_iter()
+        .map(str::to_string)
+        .collect())
 }
 
 /// The seed of instance `instance` of a sweep with seed `sweep_seed` (what the sweep ran it with).

@@ -1,6 +1,6 @@
 //! `mergesim.run`: one run of a scenario, as `merge_sim run --json --csv` makes it.
 
-use mergesim::experiment::{InstanceOptions, RunError, run_quietly};
+use mergesim::experiment::{InstanceOptions, RunError, run_instance};
 use mergesim::report::time_series_csv;
 use pyo3::prelude::*;
 
@@ -21,15 +21,15 @@ pub fn run(
     seed: Option<u64>,
 ) -> PyResult<(String, String)> {
     let scenario = source::load(scenario, params_json)?;
-    // Checked as `merge_sim run --planner` checks it (the same message).
-    if let Some(name) = planner {
-        let registry = sim::BehaviourRegistry::builtin();
-        if !registry.contains(name) {
-            return Err(BindingError::Input(mergesim::experiment::unknown_planner(
-                &registry, name,
-            ))
-            .into());
-        }
+    // The built-in planners and the Python ones registered now; the name checked as
+    // `merge_sim run --planner` checks it (the same message).
+    let registry = crate::py_planner::registry()?;
+    if let Some(name) = planner
+        && !registry.contains(name)
+    {
+        return Err(
+            BindingError::Input(mergesim::experiment::unknown_planner(&registry, name)).into(),
+        );
     }
     let planner = planner.map(str::to_string);
     let finished = run_interruptible(py, None, |interrupt| {
@@ -40,7 +40,13 @@ pub fn run(
             interrupt: Some(interrupt),
             profile: false,
         };
-        run_quietly(&scenario, &options)
+        run_instance(
+            &scenario,
+            &options,
+            sim::recording::Recorder::disabled(),
+            &registry,
+            |_| {},
+        )
     })?
     .map_err(|e| match e {
         RunError::Setup(e) => BindingError::input(&e),

@@ -22,11 +22,15 @@ pub fn study(
     out: Option<&str>,
     threads: Option<usize>,
 ) -> PyResult<String> {
-    let plan = StudyPlan::load(Path::new(plan)).map_err(|e| BindingError::input(&e))?;
+    // The built-in planners and the Python ones registered now.
+    let registry = std::sync::Arc::new(crate::py_planner::registry()?);
+    let plan =
+        StudyPlan::load_with(Path::new(plan), &registry).map_err(|e| BindingError::input(&e))?;
     let report = run_interruptible(py, Some(1), |interrupt| {
         let options = RunOptions {
             threads,
             interrupt: Some(interrupt),
+            registry,
             ..RunOptions::default()
         };
         run_and_report(&plan, &options, out.map(Path::new))

@@ -35,11 +35,14 @@ pub fn sweep(
         seed,
         shard: Shard::WHOLE,
     };
+    // The built-in planners and the Python ones registered now.
+    let registry = std::sync::Arc::new(crate::py_planner::registry()?);
     let outcome = run_interruptible(py, Some(1), |interrupt| {
         // The sweep builds its own pool of `threads` workers (one per core by default).
         let options = SweepOptions {
             threads,
             interrupt: Some(interrupt),
+            registry,
             ..SweepOptions::default()
         };
         run_paired_sweep(&plan, &options, &|_| {})
