@@ -59,22 +59,6 @@ impl TickObserver for ContactWatch {
     }
 }
 
-/// The world, handed to `Python::detach`'s closure, which runs on this same thread (it only
-/// releases the GIL): a `World` is not `Send` (its observers need not be), and nothing in it
-/// borrows from the GIL (a Python planner holds `Py` handles, which are `Send`).
-struct OnThisThread<'a>(&'a mut World);
-
-// SAFETY: `Python::detach` runs its closure on the calling thread, so the world never changes
-// threads; the bound only keeps GIL-bound references (`Bound`, `Python`) out of the closure,
-// and a `World` holds none.
-unsafe impl Send for OnThisThread<'_> {}
-
-impl<'a> OnThisThread<'a> {
-    fn into_inner(self) -> &'a mut World {
-        self.0
-    }
-}
-
 /// What one environment step did (returned to Python as a tuple).
 type StepResult = (
     Vec<Vec<f64>>,
@@ -280,10 +264,7 @@ impl EnvCore {
         };
         // Without the GIL: the world plans on a pool thread, where a Python planner (a
         // neighbour's) takes the GIL for each of its cycles.
-        let stepping = OnThisThread(world);
-        let (road_end, error) = py.detach(move || {
-            // A method call, so the closure captures the wrapper, not its field.
-            let world = stepping.into_inner();
+        let (road_end, error) = py.detach(|| {
             for _ in 0..world.steps_per_plan() {
                 match world.step() {
                     Ok(()) => {}

@@ -52,7 +52,7 @@ pub struct PlanView<'a, 'o> {
 }
 
 /// Something that watches a run (module doc). Every method defaults to doing nothing.
-pub trait TickObserver {
+pub trait TickObserver: Send {
     /// Whether [`VehicleView::received`] should be filled (it costs a look-up per vehicle).
     fn wants_received_paths(&self) -> bool {
         false

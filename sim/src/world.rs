@@ -531,3 +531,10 @@ fn check_finite(t_s: f64, name: &str, k: &Kinematics) -> Result<(), SimError> {
         })
     }
 }
+
+// A world can move to another thread (observers and behaviours are `Send`): e.g. a Python
+// binding releases the GIL while the world advances.
+const _: fn() = || {
+    fn send<T: Send>() {}
+    send::<World>();
+};
