@@ -4,8 +4,9 @@
 //! the figures are there; the stock `merge_sim` refuses the name (exit 2, listing the valid
 //! ones).
 //!
-//! `cargo test --release --test own_planner_cli` builds the example first (cargo builds a
-//! package's examples for its integration tests).
+//! `cargo test --release` builds the example first (cargo builds a package's examples for its
+//! tests); with a single test target, build it yourself first:
+//! `cargo build --release --example own_planner_cli && cargo test --release --test own_planner_cli`.
 
 mod common;
 
@@ -26,7 +27,7 @@ fn own_binary() -> PathBuf {
     assert!(
         path.is_file(),
         "{} is missing: build it with `cargo build --release --example own_planner_cli` \
-         (cargo test builds it)",
+         (a whole `cargo test` builds it, `cargo test --test own_planner_cli` does not)",
         path.display()
     );
     path
