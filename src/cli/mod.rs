@@ -18,7 +18,7 @@
 //! offending value, before any work and before anything is written; 130 / 143 interrupted by
 //! SIGINT / SIGTERM (a sweep first writes what finished).
 //!
-//! The command line only parses its arguments ([`args`]), calls the library
+//! The command line only parses its arguments (`args.rs`), calls the library
 //! ([`crate::experiment::run_instance`], [`crate::sweep`], [`crate::grid`], [`crate::study`], …)
 //! and prints or writes what it returns. Each command is one pipeline: load, check the outputs,
 //! simulate (with its observers), write.

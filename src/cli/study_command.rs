@@ -109,7 +109,6 @@ pub(crate) fn cmd_study(args: &StudyArgs, session: &Session) -> Result<(), Failu
         interrupt: Some(interrupt.flag.clone()),
         resume,
         registry: std::sync::Arc::clone(&session.registry),
-        ..RunOptions::default()
     };
     // Every check done: the folder and the rows file.
     create_out(&out).map_err(input)?;

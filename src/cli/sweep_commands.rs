@@ -112,7 +112,6 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, session: &Session) -> Result<(), Failu
         interrupt: Some(interrupt.flag.clone()),
         resume,
         registry: std::sync::Arc::clone(&session.registry),
-        ..SweepOptions::default()
     };
     // Every check before any work or any write.
     validate_paired(&plan, &options).map_err(sweep_failure)?;
