@@ -3,14 +3,15 @@
 use std::io::IsTerminal;
 use std::path::Path;
 
-use crate::output::{check_distinct, check_output_path, write_atomically};
+use anyhow::anyhow;
+use scenarios::Scenario;
+use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
+
+use crate::output::{check_distinct, check_output_path};
 use crate::report::{
     comparison_json, comparison_markdown, comparison_table, grid_table, study_table,
 };
 use crate::run_caption::RunCaption;
-use anyhow::{Context, anyhow};
-use scenarios::Scenario;
-use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
 
 use crate::cli::args::{CompareArgs, GridArgs, ManeuverArgs, ManeuverName, ScenarioCommand};
 use crate::cli::simulation::{Simulation, load_source, simulate};
@@ -91,14 +92,10 @@ pub(crate) fn cmd_compare(args: &CompareArgs, session: &Session) -> Result<(), F
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&comparison_json(&caption, &summaries))
             .map_err(run_failure)?;
-        write_atomically(path, text.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))
-            .map_err(run_failure)?;
+        write_output(path, &text)?;
     }
     if let Some(path) = &args.markdown {
-        write_atomically(path, comparison_markdown(&caption, &summaries).as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))
-            .map_err(run_failure)?;
+        write_output(path, &comparison_markdown(&caption, &summaries))?;
     }
     if let Some(dir) = &args.plots {
         let series: Vec<crate::plots::PlannerSeries<'_>> = summaries
@@ -151,9 +148,7 @@ pub(crate) fn cmd_maneuver(args: &ManeuverArgs) -> Result<(), Failure> {
     let report = run_maneuver(&config).map_err(run_failure)?;
     let text = serde_json::to_string_pretty(&report).map_err(run_failure)?;
     if let Some(path) = &args.json {
-        write_atomically(path, text.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))
-            .map_err(run_failure)?;
+        write_output(path, &text)?;
     }
     outln!("{text}");
     Ok(())
