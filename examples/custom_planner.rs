@@ -1,7 +1,8 @@
 //! Adding your own planner without editing any crate: implement `Behaviour`, register it by
 //! name, select it in a scenario, run.
 //!
-//! The planner here is a simple adaptive cruise control (ACC) on any road of lanes: it keeps the
+//! The planner here (examples/shared/time_gap_cruise.rs) is a simple adaptive cruise control
+//! (ACC) on any road of lanes: it keeps the
 //! lane it is in (its centreline, through `Observation::lanes`) and its target speed, but never
 //! closes in on a vehicle ahead in its lane (or within a metre of entering it) faster than a
 //! constant time gap allows. It broadcasts its path, so the PF-ISO ego
@@ -10,94 +11,20 @@
 //!
 //! `cargo run --release --example custom_planner`
 
-use std::sync::Arc;
-
 use mergesim::experiment::{InstanceOptions, run_instance};
 use mergesim::scenarios::Scenario;
 use mergesim::sim::recording::Recorder;
-use mergesim::sim::{
-    Behaviour, BehaviourError, BehaviourRegistry, Decision, Driver, FactoryInput, Observation,
-    PathPoint, SharedLocalPath,
-};
+use mergesim::sim::{BehaviourRegistry, Driver};
 
-/// Constant-time-gap cruise control along the through lane.
-struct TimeGapCruise {
-    /// Desired time gap to the vehicle ahead (s).
-    time_gap_s: f64,
-    /// Standstill gap, bumper to bumper (m).
-    min_gap_m: f64,
-}
-
-impl Behaviour for TimeGapCruise {
-    fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError> {
-        // The lane the car is in, and where along it (s, d) the car and the others are.
-        let here = obs.lanes.nearest_lane([obs.ego.x_m, obs.ego.y_m]);
-        let Some(lane) = obs.lanes.lane(here.lane) else {
-            return Err("the car is on no lane".into());
-        };
-        let half_width_m = 0.5 * lane.width_m(here.frame.s_m);
-        // The nearest vehicle ahead that is in this lane or within a metre of entering it.
-        let ahead = obs
-            .neighbours
-            .iter()
-            .map(|n| (n, lane.project([n.state.x_m, n.state.y_m])))
-            .filter(|(_, f)| f.s_m > here.frame.s_m && f.d_m.abs() < half_width_m + 1.0)
-            .min_by(|a, b| a.1.s_m.total_cmp(&b.1.s_m));
-        let speed_mps = match ahead {
-            Some((n, f)) => {
-                let gap_m =
-                    f.s_m - here.frame.s_m - 0.5 * (n.shape.length_m + obs.ego_shape.length_m);
-                let keeps_gap_mps = (gap_m - self.min_gap_m).max(0.0) / self.time_gap_s;
-                obs.target_speed_mps
-                    .min(keeps_gap_mps.max(n.state.speed_mps.min(obs.target_speed_mps)))
-            }
-            None => obs.target_speed_mps,
-        }
-        .max(0.5);
-        // Points along the lane's centreline (its frame continues straight past its end).
-        let path: Vec<PathPoint> = (0..=20)
-            .map(|i| {
-                let ahead_m = 4.0 * i as f64;
-                let [x_m, y_m] = if i == 0 {
-                    [obs.ego.x_m, obs.ego.y_m]
-                } else {
-                    lane.point(here.frame.s_m + ahead_m, 0.0)
-                };
-                PathPoint {
-                    x_m,
-                    y_m,
-                    speed_mps,
-                    t_s: obs.time_s + ahead_m / speed_mps,
-                }
-            })
-            .collect();
-        let broadcast = SharedLocalPath::from_path(
-            obs.ego_id,
-            obs.time_s,
-            obs.ego_shape,
-            obs.ego.speed_mps,
-            &path,
-        );
-        Ok(Decision {
-            path,
-            broadcast: Some(broadcast),
-            fallback: None,
-            degraded_mode: None,
-        })
-    }
-}
+#[path = "shared/time_gap_cruise.rs"]
+mod time_gap_cruise;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     // 1. Register the planner under a name, next to the built-in ones.
     let mut registry = BehaviourRegistry::builtin();
     registry.register(
         "time-gap-cruise",
-        Arc::new(|_: &FactoryInput<'_>| {
-            Ok(Box::new(TimeGapCruise {
-                time_gap_s: 1.5,
-                min_gap_m: 2.0,
-            }) as Box<dyn Behaviour>)
-        }),
+        time_gap_cruise::time_gap_cruise_factory(),
     )?;
 
     // 2. Select it in a scenario: the paper's urgent merge, its obstacle driven by the new

@@ -1,6 +1,7 @@
 //! mergesim: cooperative autonomous vehicles merging on a highway.
 //!
-//! The workspace's crates, re-exported for the `merge_sim` binary, the integration tests and
+//! The command line is [`cli`] (`merge_sim` is `cli::main`; a user's binary with its own planners
+//! calls [`cli::main_with`]). The workspace's crates, re-exported for the `merge_sim` binary, the integration tests and
 //! the benchmarks: [`planner`] (pure potential-field planning with interactive speed
 //! optimisation), [`vehicles`] (Rapier vehicles and tracker), [`sim`] (the closed loop) and
 //! [`scenarios`] (scenario files).
@@ -8,6 +9,7 @@
 
 pub mod animation;
 pub mod build_info;
+pub mod cli;
 pub mod exact_seed;
 pub mod experiment;
 pub mod grid;

@@ -106,7 +106,7 @@ impl PairedSweepPlan {
     pub fn labels(&self) -> Vec<String> {
         self.overrides()
             .into_iter()
-            .map(|k| planner_label(&self.scenario, k.as_deref()))
+            .map(|k| crate::experiment::planner_label(&self.scenario, k.as_deref()))
             .collect()
     }
 }
@@ -293,11 +293,6 @@ pub fn unrandomised_warning(scenario: &Scenario) -> Option<String> {
             scenario.name
         )
     })
-}
-
-/// The planner name of a sweep: the override, or the scenario's single planner, or `mixed`.
-pub fn planner_label(scenario: &Scenario, planner: Option<&str>) -> String {
-    crate::experiment::planner_label(scenario, planner)
 }
 
 /// Runs instance `seed` of the plan's scenario: what `merge_sim run --seed <seed>` runs.

@@ -7,26 +7,25 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use anyhow::{Context, anyhow};
-use clap::Args;
-use mergesim::study::report::{
+use crate::study::report::{
     self, REPORT_MD, ROWS_JSONL, StudyReport, check_out, create_out, default_out, shard_rows_file,
 };
-use mergesim::study::runner::{self, StudyRow, jsonl_line, read_rows};
-use mergesim::study::{RunOptions, StudyError, StudyPlan, analyse, provenance, run_study};
-use mergesim::sweep::Shard;
+use crate::study::runner::{self, StudyRow, jsonl_line, read_rows};
+use crate::study::{RunOptions, StudyError, StudyPlan, analyse, provenance, run_study};
+use crate::sweep::Shard;
+use anyhow::{Context, anyhow};
+use clap::Args;
 use mergesim_types::files::read_regular_text;
 
-use crate::args::{parse_shard, parse_threads};
-use crate::commands::progress_bar;
-use crate::signals::Interrupt;
-use crate::{Failure, input, interrupted, out, outln, run_failure};
+use crate::cli::args::{parse_shard, parse_threads};
+use crate::cli::commands::progress_bar;
+use crate::cli::{Failure, Session, input, interrupted, out, outln, run_failure};
 
 /// Longest rows file read back (`--resume`, `--merge`).
 const MAX_ROWS_BYTES: u64 = 1 << 30;
 
 #[derive(Args, Debug)]
-#[command(after_long_help = mergesim::study::PLAN_FORMAT)]
+#[command(after_long_help = crate::study::PLAN_FORMAT)]
 pub(crate) struct StudyArgs {
     /// The study plan (TOML; its format is below).
     #[arg(value_name = "PLAN.toml")]
@@ -64,8 +63,9 @@ fn study_failure(e: StudyError) -> Failure {
 }
 
 /// `merge_sim study`.
-pub(crate) fn cmd_study(args: &StudyArgs, interrupt: &Interrupt) -> Result<(), Failure> {
-    let plan = StudyPlan::load(&args.plan).map_err(input)?;
+pub(crate) fn cmd_study(args: &StudyArgs, session: &Session) -> Result<(), Failure> {
+    let interrupt = &session.interrupt;
+    let plan = StudyPlan::load_with(&args.plan, &session.registry).map_err(input)?;
     let out = args.out.clone().unwrap_or_else(|| default_out(&args.plan));
     check_out(&out).map_err(input)?;
     if args.merge {
@@ -108,7 +108,7 @@ pub(crate) fn cmd_study(args: &StudyArgs, interrupt: &Interrupt) -> Result<(), F
         shard: Some(shard),
         interrupt: Some(interrupt.flag.clone()),
         resume,
-        ..RunOptions::default()
+        registry: std::sync::Arc::clone(&session.registry),
     };
     // Every check done: the folder and the rows file.
     create_out(&out).map_err(input)?;
@@ -322,7 +322,7 @@ fn merge(args: &StudyArgs, plan: &StudyPlan, out: &Path) -> Result<(), Failure> 
         text.push_str(&jsonl_line(plan, row, None));
         text.push('\n');
     }
-    mergesim::output::write_atomically(&out.join(ROWS_JSONL), text.as_bytes())
+    crate::output::write_atomically(&out.join(ROWS_JSONL), text.as_bytes())
         .with_context(|| format!("cannot write {}", out.join(ROWS_JSONL).display()))
         .map_err(run_failure)?;
     finish(args, plan, out, &rows)

@@ -4,8 +4,8 @@ use mergesim_opendrive::{LaneOrigin, read_file};
 use mergesim_types::lanes::LaneRoadSpec;
 use serde::Serialize;
 
-use crate::args::OpendriveCommand;
-use crate::{Failure, input, out, run_failure};
+use crate::cli::args::OpendriveCommand;
+use crate::cli::{Failure, input, out, run_failure};
 
 /// The JSON of `merge_sim opendrive dump`.
 #[derive(Serialize)]

@@ -1,9 +1,11 @@
 //! The command line: subcommands, their options and the parsers of option values.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 use planner::ParameterSet;
+use sim::BehaviourRegistry;
 
 /// Cooperative merge simulator: potential-field planners with interactive speed optimisation
 /// (Lin et al.) on physics-based Rapier vehicles.
@@ -46,7 +48,7 @@ pub(crate) enum Command {
     /// against the reference planner (t-interval, t-test, Wilcoxon, Holm; collisions: McNemar,
     /// Newcombe), a report with tables, a figure and the plan's provenance. `merge_sim study
     /// --help` explains the plan format.
-    Study(crate::study_command::StudyArgs),
+    Study(crate::cli::study_command::StudyArgs),
     /// Print the allowed range of every scenario value and the limits on runs, threads and
     /// work, as a Markdown table (the README's "Limits" section is this output).
     Limits,
@@ -115,7 +117,7 @@ pub(crate) struct RunArgs {
     #[command(flatten)]
     pub(crate) source: ScenarioArgs,
     /// Planner of every planner-driven vehicle (overrides the scenario's choice).
-    #[arg(long, value_name = "PLANNER", value_parser = parse_planner)]
+    #[arg(long, value_name = "PLANNER")]
     pub(crate) planner: Option<String>,
     /// Run the scenario instance drawn with seed N from its [randomise] ranges (N also seeds
     /// the V2V drops); a sweep's per-run rows give each run's seed, written as 0x and 16 hex
@@ -196,7 +198,7 @@ impl RunArgs {
         self.seed.or_else(|| {
             self.sweep_seed
                 .zip(self.instance)
-                .map(|(k, i)| mergesim::sweep::instance_seed(k, i))
+                .map(|(k, i)| crate::sweep::instance_seed(k, i))
         })
     }
 }
@@ -210,7 +212,7 @@ pub(crate) enum GifViewArg {
     Follow,
 }
 
-impl From<GifViewArg> for mergesim::animation::GifView {
+impl From<GifViewArg> for crate::animation::GifView {
     fn from(view: GifViewArg) -> Self {
         match view {
             GifViewArg::Road => Self::Road,
@@ -224,8 +226,11 @@ pub(crate) struct CompareArgs {
     #[command(flatten)]
     pub(crate) source: ScenarioArgs,
     /// Planners to compare, comma-separated.
-    #[arg(long, value_delimiter = ',', value_parser = parse_planner,
-          default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred"
+    )]
     pub(crate) planners: Vec<String>,
 
     /// Compare on the scenario instance drawn with seed N (as `run --seed N`: decimal or 0x
@@ -301,13 +306,42 @@ pub(crate) enum ScenarioCommand {
     },
 }
 
-/// A registered planner name (the built-in planners).
-pub(crate) fn parse_planner(text: &str) -> Result<String, String> {
-    let registry = sim::BehaviourRegistry::builtin();
-    if registry.contains(text) {
-        Ok(text.to_string())
-    } else {
-        Err(mergesim::experiment::unknown_planner(&registry, text))
+/// Parses the process's arguments with the planners of `registry`: `--planner` / `--planners`
+/// accept exactly its names (an unknown one is clap's error, `invalid value 'X' for
+/// '--planner <PLANNER>': unknown planner 'X'; valid: …`, exit 2) and their help lists them.
+pub(crate) fn parse(registry: &Arc<BehaviourRegistry>) -> Cli {
+    let matches = command_with(registry).get_matches();
+    Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.format(&mut Cli::command()).exit())
+}
+
+/// The command line of [`Cli`] with its planner options bound to `registry`.
+pub(crate) fn command_with(registry: &Arc<BehaviourRegistry>) -> clap::Command {
+    let names = registry.names().join(", ");
+    let bind = |arg: clap::Arg| {
+        let help = arg.get_help().map(ToString::to_string).unwrap_or_default();
+        arg.value_parser(planner_parser(Arc::clone(registry)))
+            .help(format!("{help} [registered: {names}]"))
+    };
+    Cli::command()
+        .mut_arg("planner", bind)
+        .mut_subcommand("run", |c| c.mut_arg("planner", bind))
+        .mut_subcommand("compare", |c| c.mut_arg("planners", bind))
+        .mut_subcommand("sweep", |c| {
+            c.mut_arg("planner", bind).mut_arg("planners", bind)
+        })
+        .mut_subcommand("grid", |c| c.mut_arg("planners", bind))
+}
+
+/// A name `registry` holds, else [`crate::experiment::unknown_planner`]'s message.
+fn planner_parser(
+    registry: Arc<BehaviourRegistry>,
+) -> impl Fn(&str) -> Result<String, String> + Clone + Send + Sync + 'static {
+    move |text: &str| {
+        if registry.contains(text) {
+            Ok(text.to_string())
+        } else {
+            Err(crate::experiment::unknown_planner(&registry, text))
+        }
     }
 }
 
@@ -332,7 +366,7 @@ pub(crate) struct SweepArgs {
     #[command(flatten)]
     pub(crate) source: ScenarioArgs,
     /// Planner of every planner-driven vehicle (overrides the scenario's choice).
-    #[arg(long, value_name = "PLANNER", value_parser = parse_planner, conflicts_with = "planners")]
+    #[arg(long, value_name = "PLANNER", conflicts_with = "planners")]
     pub(crate) planner: Option<String>,
     /// Paired sweep: run every instance with each of these planners (comma-separated; same
     /// seed, same drawn values) and report each planner's aggregate and the paired differences
@@ -340,7 +374,7 @@ pub(crate) struct SweepArgs {
     /// baseline) and the instances where it is better / worse / tied, for collisions, near
     /// misses, min gap, min TTC, peak yaw rate, peak sideslip, min speed and each vehicle's
     /// figures and the paper's. One name is the same as --planner.
-    #[arg(long, value_name = "P1,P2,...", value_delimiter = ',', value_parser = parse_planner)]
+    #[arg(long, value_name = "P1,P2,...", value_delimiter = ',')]
     pub(crate) planners: Vec<String>,
     /// Number of randomised instances in the whole sweep (1 to 1000000); each runs once per
     /// planner.
@@ -358,7 +392,7 @@ pub(crate) struct SweepArgs {
     /// alone (`sbatch --array=2`) is an array of one task and would run the whole sweep. The
     /// sweep prints its shard on stderr, even with --quiet.
     #[arg(long, value_name = "i/n", value_parser = parse_shard)]
-    pub(crate) shard: Option<mergesim::sweep::Shard>,
+    pub(crate) shard: Option<crate::sweep::Shard>,
     /// Write the aggregate JSON here (with per-run samples, so shards can be merged).
     #[arg(long, value_name = "PATH")]
     pub(crate) json: Option<PathBuf>,
@@ -421,8 +455,11 @@ pub(crate) struct GridArgs {
     #[command(flatten)]
     pub(crate) source: ScenarioArgs,
     /// Planners, comma-separated; the first is the reference of the paired differences.
-    #[arg(long, value_delimiter = ',', value_parser = parse_planner,
-          default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "pf-cs,pf-sp,pf-iso,pf-iso-pred"
+    )]
     pub(crate) planners: Vec<String>,
     /// Path-field time gaps τ (s), comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "0,1,2,3", value_parser = parse_gap)]
@@ -468,11 +505,11 @@ pub(crate) struct GridArgs {
 /// A seed: decimal digits or 0x and hex digits (what the result files write); a float is
 /// refused, as it cannot be an exact seed.
 pub(crate) fn parse_seed(text: &str) -> Result<u64, String> {
-    mergesim::exact_seed::parse_seed(text).map_err(|e| e.to_string())
+    crate::exact_seed::parse_seed(text).map_err(|e| e.to_string())
 }
 
 pub(crate) fn parse_runs(text: &str) -> Result<u64, String> {
-    use mergesim::sweep::MAX_RUNS;
+    use crate::sweep::MAX_RUNS;
     match text.parse::<u64>() {
         Ok(n) if (1..=MAX_RUNS).contains(&n) => Ok(n),
         _ => Err(format!(
@@ -483,7 +520,7 @@ pub(crate) fn parse_runs(text: &str) -> Result<u64, String> {
 }
 
 pub(crate) fn parse_threads(text: &str) -> Result<usize, String> {
-    use mergesim::sweep::MAX_THREADS;
+    use crate::sweep::MAX_THREADS;
     match text.parse::<usize>() {
         Ok(n) if (1..=MAX_THREADS).contains(&n) => Ok(n),
         _ => Err(format!(
@@ -492,9 +529,9 @@ pub(crate) fn parse_threads(text: &str) -> Result<usize, String> {
     }
 }
 
-pub(crate) fn parse_shard(text: &str) -> Result<mergesim::sweep::Shard, String> {
+pub(crate) fn parse_shard(text: &str) -> Result<crate::sweep::Shard, String> {
     text.parse()
-        .map_err(|e: mergesim::sweep::ShardError| e.to_string())
+        .map_err(|e: crate::sweep::ShardError| e.to_string())
 }
 
 pub(crate) fn parse_gap(text: &str) -> Result<f64, String> {

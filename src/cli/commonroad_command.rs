@@ -7,8 +7,8 @@ use mergesim_commonroad::read_with_road;
 use mergesim_types::lanes::LaneRoadSpec;
 use serde::Serialize;
 
-use crate::args::CommonroadCommand;
-use crate::{Failure, input, out, run_failure};
+use crate::cli::args::CommonroadCommand;
+use crate::cli::{Failure, input, out, run_failure};
 
 /// The JSON of `merge_sim commonroad dump`.
 #[derive(Serialize)]

@@ -4,15 +4,15 @@
 use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
+use crate::output::check_output_path;
 use anyhow::{Context, anyhow};
-use mergesim::output::check_output_path;
 use mergesim_types::files::read_regular_text;
 
-use crate::args::{MergeResultsArgs, SweepArgs};
-use crate::commands::{check_outputs, progress_bar, scenario_file};
-use crate::signals::Interrupt;
-use crate::{
-    Failure, input, interrupted, load_source, out, outln, run_failure, sweep_failure, write_output,
+use crate::cli::args::{MergeResultsArgs, SweepArgs};
+use crate::cli::commands::{check_outputs, progress_bar, scenario_file};
+use crate::cli::simulation::load_source;
+use crate::cli::{
+    Failure, Session, input, interrupted, out, outln, run_failure, sweep_failure, write_output,
 };
 
 /// Longest sweep result file read back (`--resume`, `merge-results`): 4 GiB, beyond the rows
@@ -20,8 +20,9 @@ use crate::{
 const MAX_RESULT_FILE_BYTES: u64 = 4 << 30;
 
 /// `merge_sim sweep`: checks every input and output, then runs (or resumes) the sweep.
-pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), Failure> {
-    use mergesim::sweep::{
+pub(crate) fn cmd_sweep(args: &SweepArgs, session: &Session) -> Result<(), Failure> {
+    let interrupt = &session.interrupt;
+    use crate::sweep::{
         PairedSweepPlan, Shard, SweepIdentity, SweepOptions, resume::read_jsonl, run_paired_sweep,
         validate_paired,
     };
@@ -110,7 +111,7 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
         threads: args.threads,
         interrupt: Some(interrupt.flag.clone()),
         resume,
-        ..SweepOptions::default()
+        registry: std::sync::Arc::clone(&session.registry),
     };
     // Every check before any work or any write.
     validate_paired(&plan, &options).map_err(sweep_failure)?;
@@ -140,7 +141,7 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
             )
         }
     );
-    if let Some(warning) = mergesim::sweep::unrandomised_warning(&plan.scenario)
+    if let Some(warning) = crate::sweep::unrandomised_warning(&plan.scenario)
         && !args.quiet
     {
         eprintln!("warning: {warning}");
@@ -151,10 +152,10 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
         format!("sweep {} shard {shard}", plan.scenario.name),
     );
     let write_error: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
-    let on_run = |run: &mergesim::sweep::FinishedRun| {
+    let on_run = |run: &crate::sweep::FinishedRun| {
         bar.inc(1);
         let Some(writer) = &writer else { return };
-        let line = match mergesim::sweep::jsonl_line(&identity, &run.row, run.wall_time_s) {
+        let line = match crate::sweep::jsonl_line(&identity, &run.row, run.wall_time_s) {
             Ok(line) => line,
             Err(e) => {
                 record_first(&write_error, e.to_string());
@@ -208,14 +209,14 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, interrupt: &Interrupt) -> Result<(), F
                 } else {
                     String::new()
                 },
-                mergesim::exact_seed::format_seed(row.seed),
+                crate::exact_seed::format_seed(row.seed),
                 row.status,
                 row.error.as_deref().unwrap_or_default()
             );
         }
     }
     let finished: u64 = outcome.summaries.iter().map(|s| s.runs).sum();
-    use mergesim::sweep::SweepVerdict;
+    use crate::sweep::SweepVerdict;
     match outcome.verdict() {
         SweepVerdict::Complete => Ok(()),
         SweepVerdict::Interrupted { missing } => Err(interrupted(
@@ -290,7 +291,7 @@ fn open_jsonl(
 
 /// Writes a sweep's report: the aggregate as JSON, the rows as Parquet.
 fn write_report(
-    report: &mergesim::sweep::SweepReport,
+    report: &crate::sweep::SweepReport,
     json: Option<&Path>,
     parquet: Option<&Path>,
 ) -> Result<(), Failure> {
@@ -299,14 +300,14 @@ fn write_report(
         write_output(path, &text)?;
     }
     if let Some(path) = parquet {
-        mergesim::sweep::parquet::write_parquet(path, report).map_err(run_failure)?;
+        crate::sweep::parquet::write_parquet(path, report).map_err(run_failure)?;
     }
     Ok(())
 }
 
 /// `merge_sim merge-results`: validates the shards of one sweep and writes their aggregate.
 pub(crate) fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> {
-    use mergesim::sweep::{SweepReport, merge_reports};
+    use crate::sweep::{SweepReport, merge_reports};
     let inputs: Vec<&Path> = args.inputs.iter().map(PathBuf::as_path).collect();
     check_outputs(
         &[
@@ -332,7 +333,7 @@ pub(crate) fn cmd_merge_results(args: &MergeResultsArgs) -> Result<(), Failure> 
     let rows = match &args.jsonl {
         Some(path) => Some((
             path,
-            mergesim::sweep::merged_jsonl(&merged).map_err(run_failure)?,
+            crate::sweep::merged_jsonl(&merged).map_err(run_failure)?,
         )),
         None => None,
     };
