@@ -62,6 +62,8 @@
 //! logged into the blueprint store next to the views it writes (`rerun_file::blueprint_messages`).
 //! Disable the blueprint with [`RecorderParams::blueprint`].
 
+#[cfg(feature = "rerun")]
+mod blueprint;
 mod colors;
 #[cfg(feature = "rerun")]
 mod entities;
@@ -69,6 +71,8 @@ mod entities;
 mod recorded_entities;
 #[cfg(feature = "rerun")]
 mod rerun_file;
+#[cfg(feature = "rerun")]
+mod rrd_writer;
 pub mod size_estimate;
 #[cfg(not(feature = "rerun"))]
 mod without_rerun;
