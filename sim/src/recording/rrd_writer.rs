@@ -12,12 +12,19 @@
 //!   [`CHUNK_MAX_ROWS`] rows or [`CHUNK_MAX_BYTES`] bytes, and at the end in the order the
 //!   entities first appeared: by count, never by time;
 //! - the footer (Rerun's index of the chunks) lists the stores in a fixed order (the blueprint,
-//!   then the recording), where Rerun's own encoder follows a `HashMap`'s random order.
+//!   then the recording), where Rerun's own encoder follows a `HashMap`'s random order, and its
+//!   schema's columns sorted.
+//!
+//! The chunks are built on the caller's thread and encoded (Arrow IPC, LZ4) and written by one
+//! writer thread, in the order they were built: the thread changes when bytes are written,
+//! never which.
 
 use std::collections::HashMap;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::thread::JoinHandle;
 
 use rerun::external::re_log_encoding::{
     self, CrateVersion, Encodable, EncodingOptions, MessageHeader, MessageKind, RawRrdManifest,
@@ -30,9 +37,11 @@ use rerun::{AsComponents, EntityPath, SerializedComponentBatch, TimeCell, TimePo
 use super::RecordingError;
 
 /// A chunk is cut when it holds this many rows…
-pub(super) const CHUNK_MAX_ROWS: usize = 4096;
+pub(super) const CHUNK_MAX_ROWS: usize = 256;
 /// …or this many bytes of (uncompressed) component data.
-pub(super) const CHUNK_MAX_BYTES: usize = 1 << 20;
+pub(super) const CHUNK_MAX_BYTES: usize = 256 << 10;
+/// Chunks waiting for the writer thread (the caller waits when it is behind).
+const CHUNKS_IN_FLIGHT: usize = 64;
 
 /// Rows waiting to become a chunk: one entity, static or not, one archetype.
 struct Pending {
@@ -50,14 +59,31 @@ struct Store {
     has_chunks: bool,
 }
 
-/// Writes an `.rrd` file with deterministic ids, chunks and footer.
-pub(super) struct RrdWriter {
+/// What the writer thread is sent.
+enum Job {
+    /// A chunk (its ids set) of store `.0`.
+    Chunk(usize, Chunk),
+    /// A message that is not data.
+    Msg(LogMsg),
+}
+
+/// The file and its footer: owned by the writer thread once the stream header and the store
+/// infos are written.
+struct FileSide {
     path: PathBuf,
     out: BufWriter<File>,
     /// Bytes written so far.
     offset: u64,
     options: EncodingOptions,
     stores: Vec<Store>,
+}
+
+/// Writes an `.rrd` file with deterministic ids, chunks and footer.
+pub(super) struct RrdWriter {
+    store_ids: Vec<StoreId>,
+    /// To the writer thread; `None` once finished.
+    jobs: Option<SyncSender<Job>>,
+    writer: Option<JoinHandle<Result<(), RecordingError>>>,
     /// The last id handed out (rows and chunks share the sequence).
     last_id: u64,
     /// The current time of the data logged with [`Self::log`].
@@ -83,63 +109,7 @@ fn encode_error(call: &'static str, err: impl std::fmt::Display) -> RecordingErr
     }
 }
 
-impl RrdWriter {
-    /// Creates `path` and writes the stream header and the store infos of `stores` (in this
-    /// order; the first is store 0 of [`Self::log_to`]).
-    pub(super) fn create(path: &Path, stores: Vec<StoreInfo>) -> Result<Self, RecordingError> {
-        let file = File::create(path).map_err(|e| io_error(path, e))?;
-        let options = EncodingOptions::PROTOBUF_COMPRESSED;
-        let mut writer = Self {
-            path: path.to_path_buf(),
-            out: BufWriter::with_capacity(1 << 20, file),
-            offset: 0,
-            options,
-            stores: Vec::new(),
-            last_id: 0,
-            timepoint: TimePoint::default(),
-            pending: Vec::new(),
-            pending_index: HashMap::new(),
-        };
-        let mut header = Vec::new();
-        StreamHeader {
-            fourcc: re_log_encoding::RRD_FOURCC,
-            version: CrateVersion::LOCAL.to_bytes(),
-            options,
-        }
-        .to_rrd_bytes(&mut header)
-        .map_err(|e| encode_error("rrd header", e))?;
-        writer.write_bytes(&header)?;
-        for info in stores {
-            let id = info.store_id.clone();
-            let row_id = writer.next_row_id();
-            writer.write_msg(&LogMsg::SetStoreInfo(SetStoreInfo {
-                row_id: *row_id,
-                info,
-            }))?;
-            writer.stores.push(Store {
-                id,
-                manifest: RrdManifestBuilder::default(),
-                has_chunks: false,
-            });
-        }
-        Ok(writer)
-    }
-
-    /// The id of store `store`.
-    pub(super) fn store_id(&self, store: usize) -> Option<&StoreId> {
-        self.stores.get(store).map(|s| &s.id)
-    }
-
-    /// The next id: a TUID of time 0 and increment `last_id + 1`.
-    fn next_id(&mut self) -> u128 {
-        self.last_id += 1;
-        u128::from(self.last_id)
-    }
-
-    fn next_row_id(&mut self) -> RowId {
-        RowId::from_u128(self.next_id())
-    }
-
+impl FileSide {
     fn write_bytes(&mut self, bytes: &[u8]) -> Result<(), RecordingError> {
         self.out
             .write_all(bytes)
@@ -163,6 +133,198 @@ impl RrdWriter {
         let len = (bytes.len() as u64).saturating_sub(header_bytes);
         self.write_bytes(&bytes)?;
         Ok((start, len, transport.byte_size_uncompressed()))
+    }
+
+    /// Writes `chunk` (its ids already set) into store `store` and indexes it in the footer.
+    fn write_chunk(&mut self, store: usize, chunk: &Chunk) -> Result<(), RecordingError> {
+        let Some(store_id) = self.stores.get(store).map(|s| s.id.clone()) else {
+            return Err(encode_error("rrd chunk", format!("no store {store}")));
+        };
+        let batch = chunk
+            .to_chunk_batch()
+            .map_err(|e| encode_error("rrd chunk", e))?;
+        let msg = LogMsg::ArrowMsg(
+            store_id,
+            ArrowMsg {
+                chunk_id: chunk.id().as_tuid(),
+                batch: batch.clone().into(),
+                on_release: None,
+            },
+        );
+        let (start, len, uncompressed) = self.write_msg(&msg)?;
+        if let Some(s) = self.stores.get_mut(store) {
+            s.manifest
+                .append(
+                    &batch,
+                    re_span::Span::from_start_len(start, len),
+                    uncompressed,
+                )
+                .map_err(|e| encode_error("rrd footer", e))?;
+            s.has_chunks = true;
+        }
+        Ok(())
+    }
+
+    /// The writer thread: writes the jobs in order until the channel closes, then the footer.
+    fn run(mut self, jobs: Receiver<Job>) -> Result<(), RecordingError> {
+        for job in jobs {
+            match job {
+                Job::Chunk(store, chunk) => self.write_chunk(store, &chunk)?,
+                Job::Msg(msg) => {
+                    self.write_msg(&msg)?;
+                }
+            }
+        }
+        self.finish()
+    }
+
+    /// Writes the footer (the stores in their order) and flushes the file.
+    fn finish(mut self) -> Result<(), RecordingError> {
+        let stores = std::mem::take(&mut self.stores);
+        let mut footer: Option<<RrdFooter as ToTransport>::Output> = None;
+        for store in stores.into_iter().filter(|s| s.has_chunks) {
+            let mut manifest: RawRrdManifest = store
+                .manifest
+                .build(store.id.clone())
+                .map_err(|e| encode_error("rrd footer", e))?;
+            // The schema's columns come out of a `HashMap` in a random order: sorted, as Rerun
+            // already sorts them for the schema's hash.
+            let mut fields = manifest.sorbet_schema.fields().to_vec();
+            fields.sort();
+            manifest.sorbet_schema = rerun::external::arrow::datatypes::Schema::new_with_metadata(
+                fields,
+                manifest.sorbet_schema.metadata().clone(),
+            );
+            // One store per `RrdFooter` (its map's order is random), joined in our order.
+            let one = RrdFooter {
+                manifests: HashMap::from([(store.id, manifest)]),
+            }
+            .to_transport(())
+            .map_err(|e| encode_error("rrd footer", e))?;
+            match &mut footer {
+                Some(f) => f.manifests.extend(one.manifests),
+                None => footer = Some(one),
+            }
+        }
+        if let Some(footer) = footer {
+            let mut footer_bytes = Vec::new();
+            footer
+                .to_rrd_bytes(&mut footer_bytes)
+                .map_err(|e| encode_error("rrd footer", e))?;
+            let mut header = Vec::new();
+            MessageHeader {
+                kind: MessageKind::End,
+                len: footer_bytes.len() as u64,
+            }
+            .to_rrd_bytes(&mut header)
+            .map_err(|e| encode_error("rrd footer", e))?;
+            self.write_bytes(&header)?;
+            let footer_offset = self.offset;
+            self.write_bytes(&footer_bytes)?;
+            let mut stream_footer = Vec::new();
+            StreamFooter::from_rrd_footer_bytes(footer_offset, &footer_bytes)
+                .to_rrd_bytes(&mut stream_footer)
+                .map_err(|e| encode_error("rrd footer", e))?;
+            self.write_bytes(&stream_footer)?;
+        }
+        let path = self.path.clone();
+        let file = self
+            .out
+            .into_inner()
+            .map_err(|e| io_error(&path, e.into_error()))?;
+        file.sync_all().map_err(|e| io_error(&path, e))
+    }
+}
+
+impl RrdWriter {
+    /// Creates `path`, writes the stream header and the store infos of `stores` (in this
+    /// order; the first is store 0 of [`Self::log_to`]) and starts the writer thread.
+    pub(super) fn create(path: &Path, stores: Vec<StoreInfo>) -> Result<Self, RecordingError> {
+        let file = File::create(path).map_err(|e| io_error(path, e))?;
+        let options = EncodingOptions::PROTOBUF_COMPRESSED;
+        let mut file_side = FileSide {
+            path: path.to_path_buf(),
+            out: BufWriter::with_capacity(1 << 20, file),
+            offset: 0,
+            options,
+            stores: Vec::new(),
+        };
+        let mut header = Vec::new();
+        StreamHeader {
+            fourcc: re_log_encoding::RRD_FOURCC,
+            version: CrateVersion::LOCAL.to_bytes(),
+            options,
+        }
+        .to_rrd_bytes(&mut header)
+        .map_err(|e| encode_error("rrd header", e))?;
+        file_side.write_bytes(&header)?;
+        let mut writer = Self {
+            store_ids: Vec::new(),
+            jobs: None,
+            writer: None,
+            last_id: 0,
+            timepoint: TimePoint::default(),
+            pending: Vec::new(),
+            pending_index: HashMap::new(),
+        };
+        for info in stores {
+            let id = info.store_id.clone();
+            let row_id = writer.next_row_id();
+            file_side.write_msg(&LogMsg::SetStoreInfo(SetStoreInfo {
+                row_id: *row_id,
+                info,
+            }))?;
+            writer.store_ids.push(id.clone());
+            file_side.stores.push(Store {
+                id,
+                manifest: RrdManifestBuilder::default(),
+                has_chunks: false,
+            });
+        }
+        let (jobs, received) = sync_channel(CHUNKS_IN_FLIGHT);
+        let handle = std::thread::Builder::new()
+            .name("rrd_writer".into())
+            .spawn(move || file_side.run(received))
+            .map_err(|e| io_error(path, e))?;
+        writer.jobs = Some(jobs);
+        writer.writer = Some(handle);
+        Ok(writer)
+    }
+
+    /// The next id: a TUID of time 0 and increment `last_id + 1`.
+    fn next_id(&mut self) -> u128 {
+        self.last_id += 1;
+        u128::from(self.last_id)
+    }
+
+    fn next_row_id(&mut self) -> RowId {
+        RowId::from_u128(self.next_id())
+    }
+
+    /// Hands `job` to the writer thread; if it has stopped, its error.
+    fn send(&mut self, job: Job) -> Result<(), RecordingError> {
+        let sent = match &self.jobs {
+            Some(jobs) => jobs.send(job).is_ok(),
+            None => false,
+        };
+        if sent {
+            Ok(())
+        } else {
+            // The thread stopped on an error: report it.
+            self.join()?;
+            Err(encode_error("rrd writer", "the writer thread has stopped"))
+        }
+    }
+
+    /// Closes the channel and waits for the writer thread (which writes the footer).
+    fn join(&mut self) -> Result<(), RecordingError> {
+        self.jobs = None;
+        match self.writer.take() {
+            Some(handle) => handle
+                .join()
+                .map_err(|_| encode_error("rrd writer", "the writer thread panicked"))?,
+            None => Ok(()),
+        }
     }
 
     /// Sets the time of the data logged from now on.
@@ -272,41 +434,7 @@ impl RrdWriter {
         }
         let chunk = builder.build().map_err(|e| encode_error("rrd chunk", e))?;
         debug_assert_eq!(chunk.is_static(), is_static);
-        self.write_chunk(store, &chunk)
-    }
-
-    /// Writes `chunk` (its ids already set) into store `store`.
-    pub(super) fn write_chunk(
-        &mut self,
-        store: usize,
-        chunk: &Chunk,
-    ) -> Result<(), RecordingError> {
-        let Some(store_id) = self.store_id(store).cloned() else {
-            return Err(encode_error("rrd chunk", format!("no store {store}")));
-        };
-        let batch = chunk
-            .to_chunk_batch()
-            .map_err(|e| encode_error("rrd chunk", e))?;
-        let msg = LogMsg::ArrowMsg(
-            store_id,
-            ArrowMsg {
-                chunk_id: chunk.id().as_tuid(),
-                batch: batch.clone().into(),
-                on_release: None,
-            },
-        );
-        let (start, len, uncompressed) = self.write_msg(&msg)?;
-        if let Some(s) = self.stores.get_mut(store) {
-            s.manifest
-                .append(
-                    &batch,
-                    re_span::Span::from_start_len(start, len),
-                    uncompressed,
-                )
-                .map_err(|e| encode_error("rrd footer", e))?;
-            s.has_chunks = true;
-        }
-        Ok(())
+        self.send(Job::Chunk(store, chunk))
     }
 
     /// Writes every pending row of store `store` (in the order their entities first appeared).
@@ -321,66 +449,23 @@ impl RrdWriter {
 
     /// Writes a message that is not data (the blueprint's activation).
     pub(super) fn write_command(&mut self, msg: &LogMsg) -> Result<(), RecordingError> {
-        self.write_msg(msg).map(|_| ())
+        self.send(Job::Msg(msg.clone()))
     }
 
-    /// Writes the pending rows, the footer (the stores in their order) and flushes the file.
+    /// Writes the pending rows, then waits for the writer thread to write them and the footer
+    /// and to flush the file.
     pub(super) fn finish(mut self) -> Result<(), RecordingError> {
-        for store in 0..self.stores.len() {
+        for store in 0..self.store_ids.len() {
             self.flush_store(store)?;
         }
-        let stores = std::mem::take(&mut self.stores);
-        let mut footer: Option<<RrdFooter as ToTransport>::Output> = None;
-        for store in stores.into_iter().filter(|s| s.has_chunks) {
-            let mut manifest: RawRrdManifest = store
-                .manifest
-                .build(store.id.clone())
-                .map_err(|e| encode_error("rrd footer", e))?;
-            // The schema's columns come out of a `HashMap` in a random order: sorted, as Rerun
-            // already sorts them for the schema's hash.
-            let mut fields = manifest.sorbet_schema.fields().to_vec();
-            fields.sort();
-            manifest.sorbet_schema = rerun::external::arrow::datatypes::Schema::new_with_metadata(
-                fields,
-                manifest.sorbet_schema.metadata().clone(),
-            );
-            // One store per `RrdFooter` (its map's order is random), joined in our order.
-            let one = RrdFooter {
-                manifests: HashMap::from([(store.id, manifest)]),
-            }
-            .to_transport(())
-            .map_err(|e| encode_error("rrd footer", e))?;
-            match &mut footer {
-                Some(f) => f.manifests.extend(one.manifests),
-                None => footer = Some(one),
-            }
-        }
-        if let Some(footer) = footer {
-            let mut footer_bytes = Vec::new();
-            footer
-                .to_rrd_bytes(&mut footer_bytes)
-                .map_err(|e| encode_error("rrd footer", e))?;
-            let mut header = Vec::new();
-            MessageHeader {
-                kind: MessageKind::End,
-                len: footer_bytes.len() as u64,
-            }
-            .to_rrd_bytes(&mut header)
-            .map_err(|e| encode_error("rrd footer", e))?;
-            self.write_bytes(&header)?;
-            let footer_offset = self.offset;
-            self.write_bytes(&footer_bytes)?;
-            let mut stream_footer = Vec::new();
-            StreamFooter::from_rrd_footer_bytes(footer_offset, &footer_bytes)
-                .to_rrd_bytes(&mut stream_footer)
-                .map_err(|e| encode_error("rrd footer", e))?;
-            self.write_bytes(&stream_footer)?;
-        }
-        let path = self.path.clone();
-        let file = self
-            .out
-            .into_inner()
-            .map_err(|e| io_error(&path, e.into_error()))?;
-        file.sync_all().map_err(|e| io_error(&path, e))
+        self.join()
+    }
+}
+
+impl Drop for RrdWriter {
+    /// Without [`RrdWriter::finish`] (a failed run): the thread ends the file, which the caller
+    /// deletes; it is waited for, so that the deletion comes after the last write.
+    fn drop(&mut self) {
+        self.join().ok();
     }
 }
