@@ -9,11 +9,8 @@ use rerun::external::re_log_types::{BlueprintActivationCommand, StoreId, StoreIn
 use rerun::log::LogMsg;
 use rerun::{StoreKind, TimePoint};
 
-use super::rrd_writer::RrdWriter;
+use super::rrd_writer::{BLUEPRINT_STORE, RrdWriter};
 use super::{EventLevel, Recorder, RecorderParams, RecordingError, SIM_TIMELINE, check_finite};
-
-/// Store 0 of the file: the blueprint.
-const BLUEPRINT_STORE: usize = 0;
 
 /// The recording id of a file named `file_name`: the name itself, so that the same run recorded
 /// twice under the same name gives the same bytes (wherever the file is), and files of
@@ -70,10 +67,10 @@ impl Recorder {
         }
         let mut stream = RrdWriter::create(
             &tmp_path,
-            vec![
-                StoreInfo::new(blueprint_id.clone(), source.clone()),
-                StoreInfo::new(recording_store, source),
-            ],
+            params
+                .blueprint
+                .then(|| StoreInfo::new(blueprint_id.clone(), source.clone())),
+            StoreInfo::new(recording_store, source),
         )?;
         if params.blueprint {
             // The default layout, complete before its activation (as the SDK sends it).

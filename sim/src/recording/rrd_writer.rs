@@ -32,7 +32,7 @@ use rerun::external::re_log_encoding::{
 };
 use rerun::external::re_log_types::{ArrowMsg, SetStoreInfo, StoreId, StoreInfo};
 use rerun::log::{Chunk, ChunkId, LogMsg, RowId};
-use rerun::{AsComponents, EntityPath, SerializedComponentBatch, TimeCell, TimePoint};
+use rerun::{AsComponents, EntityPath, SerializedComponentBatch, StoreKind, TimeCell, TimePoint};
 
 use super::RecordingError;
 
@@ -40,6 +40,10 @@ use super::RecordingError;
 pub(super) const CHUNK_MAX_ROWS: usize = 256;
 /// …or this many bytes of (uncompressed) component data.
 pub(super) const CHUNK_MAX_BYTES: usize = 256 << 10;
+/// The blueprint's store.
+pub(super) const BLUEPRINT_STORE: usize = 0;
+/// The recording's store.
+pub(super) const RECORDING_STORE: usize = 1;
 /// Chunks waiting for the writer thread (the caller waits when it is behind).
 const CHUNKS_IN_FLIGHT: usize = 64;
 
@@ -237,9 +241,13 @@ impl FileSide {
 }
 
 impl RrdWriter {
-    /// Creates `path`, writes the stream header and the store infos of `stores` (in this
-    /// order; the first is store 0 of [`Self::log_to`]) and starts the writer thread.
-    pub(super) fn create(path: &Path, stores: Vec<StoreInfo>) -> Result<Self, RecordingError> {
+    /// Creates `path`, writes the stream header and the store infos of the blueprint (if any:
+    /// [`BLUEPRINT_STORE`]) and the recording ([`RECORDING_STORE`]) and starts the writer thread.
+    pub(super) fn create(
+        path: &Path,
+        blueprint: Option<StoreInfo>,
+        recording: StoreInfo,
+    ) -> Result<Self, RecordingError> {
         let file = File::create(path).map_err(|e| io_error(path, e))?;
         let options = EncodingOptions::PROTOBUF_COMPRESSED;
         let mut file_side = FileSide {
@@ -267,13 +275,28 @@ impl RrdWriter {
             pending: Vec::new(),
             pending_index: HashMap::new(),
         };
-        for info in stores {
-            let id = info.store_id.clone();
-            let row_id = writer.next_row_id();
-            file_side.write_msg(&LogMsg::SetStoreInfo(SetStoreInfo {
-                row_id: *row_id,
-                info,
-            }))?;
+        // Without a blueprint, its store is never announced (and gets no rows).
+        let blueprint_id = blueprint.as_ref().map_or_else(
+            || {
+                StoreId::new(
+                    StoreKind::Blueprint,
+                    recording.application_id().clone(),
+                    recording.recording_id().clone(),
+                )
+            },
+            |b| b.store_id.clone(),
+        );
+        for (id, info) in [
+            (blueprint_id, blueprint),
+            (recording.store_id.clone(), Some(recording)),
+        ] {
+            if let Some(info) = info {
+                let row_id = writer.next_row_id();
+                file_side.write_msg(&LogMsg::SetStoreInfo(SetStoreInfo {
+                    row_id: *row_id,
+                    info,
+                }))?;
+            }
             writer.store_ids.push(id.clone());
             file_side.stores.push(Store {
                 id,
@@ -344,22 +367,32 @@ impl RrdWriter {
         self.timepoint = timepoint;
     }
 
-    /// Logs `value` at `path` in the recording (store 1) at the current time.
+    /// Logs `value` at `path` in the recording at the current time.
     pub(super) fn log<AS: ?Sized + AsComponents>(
         &mut self,
         path: impl Into<EntityPath>,
         value: &AS,
     ) -> Result<(), RecordingError> {
-        self.log_to(1, path.into(), false, value.as_serialized_batches())
+        self.log_to(
+            RECORDING_STORE,
+            path.into(),
+            false,
+            value.as_serialized_batches(),
+        )
     }
 
-    /// Logs `value` at `path` in the recording (store 1) as static data.
+    /// Logs `value` at `path` in the recording as static data.
     pub(super) fn log_static<AS: ?Sized + AsComponents>(
         &mut self,
         path: impl Into<EntityPath>,
         value: &AS,
     ) -> Result<(), RecordingError> {
-        self.log_to(1, path.into(), true, value.as_serialized_batches())
+        self.log_to(
+            RECORDING_STORE,
+            path.into(),
+            true,
+            value.as_serialized_batches(),
+        )
     }
 
     /// Adds a row to store `store`: static, or at the current time.
