@@ -157,8 +157,8 @@ impl Recorder {
 
     /// Logs the field's colour bar (static): a gradient image one unit high and
     /// `COLOR_BAR_STEPS` wide, with labelled ticks under it.
-    pub(super) fn log_field_legend(&self) -> Result<(), RecordingError> {
-        let Some(active) = &self.active else {
+    pub(super) fn log_field_legend(&mut self) -> Result<(), RecordingError> {
+        let Some(active) = &mut self.active else {
             return Ok(());
         };
         let scale = self.params.field_color_scale;
@@ -307,7 +307,7 @@ impl Recorder {
         let points: Vec<[f32; 2]> = path.iter().map(|p| [p.x_m as f32, p.y_m as f32]).collect();
         let base = format!("world/paths/{}", entity_part(name));
         let radius = self.params.path_line_radius_m as f32;
-        let Some(active) = &self.active else {
+        let Some(active) = &mut self.active else {
             return Ok(());
         };
         active.stream.log(
@@ -333,7 +333,7 @@ impl Recorder {
         name: &str,
         paths: &[SharedLocalPath],
     ) -> Result<(), RecordingError> {
-        let Some(active) = &self.active else {
+        let Some(active) = &mut self.active else {
             return Ok(());
         };
         for slp in paths {
@@ -383,7 +383,7 @@ impl Recorder {
         height: usize,
         values: &[f64],
     ) -> Result<(), RecordingError> {
-        let Some(active) = &self.active else {
+        let Some(active) = &mut self.active else {
             return Ok(());
         };
         check_finite("log_field", "the grid origin", &[x0_m, y0_m])?;

@@ -57,11 +57,20 @@
 //! # Blueprint
 //! The file starts with a default layout: the follow view over the whole-road view, the field's
 //! colour bar and the event log on the left, one time-series view per series (title with units,
-//! fixed y range, legend in a corner) on the right. The 0.36 Rust SDK's `Spatial2DView` and
-//! `TimeSeriesView` builders cannot set visual bounds or axes, so those view properties are
-//! logged into the blueprint store next to the views it writes (`rerun_file::blueprint_messages`).
+//! fixed y range, legend in a corner) on the right. It is written as the archetypes the SDK's
+//! blueprint builders write (views, containers, viewport, panels) plus the view properties they
+//! cannot set (visual bounds, axes, legends), with fixed ids (`blueprint`).
 //! Disable the blueprint with [`RecorderParams::blueprint`].
+//!
+//! # The same bytes for the same run
+//! The file is written by `rrd_writer`, not by the SDK's `RecordingStream`: row and chunk ids
+//! count up from 1, the recording id is the file's name, the only timeline is `sim_time` (data
+//! logged before the first [`Recorder::set_time`] is at 0), chunks are cut by rows and bytes
+//! (never by a timer) and the footer's stores come in a fixed order. So the same run gives the
+//! same bytes on any machine and any thread count (`tests/recording_bytes.rs`).
 
+#[cfg(feature = "rerun")]
+mod blueprint;
 mod colors;
 #[cfg(feature = "rerun")]
 mod entities;
@@ -69,6 +78,8 @@ mod entities;
 mod recorded_entities;
 #[cfg(feature = "rerun")]
 mod rerun_file;
+#[cfg(feature = "rerun")]
+mod rrd_writer;
 pub mod size_estimate;
 #[cfg(not(feature = "rerun"))]
 mod without_rerun;
@@ -174,7 +185,7 @@ pub struct RecorderParams {
     /// Potential fields and received shared paths are recorded for the first this many
     /// vehicles (by id) only; `None`: for all. Boxes, planned paths, time series and events are
     /// recorded for every vehicle. Both grow with the number of vehicles (received paths with
-    /// its square): with 50 vehicles they make a 72 s recording ~0.5 GB (1 GB in 3D).
+    /// its square): with 50 vehicles the size estimate puts a 72 s recording at ~0.5 GB.
     pub detail_vehicles: Option<usize>,
     /// Write each lane's id on the road (`world/road/lane_ids`; `merge_sim run --lane-ids`).
     pub lane_ids: bool,

@@ -1,22 +1,24 @@
 //! How large a recording will be, before writing it (`merge_sim run` warns above 500 MB).
 //!
-//! A linear model in what is logged, refitted on 2026-12-02 to the top-down 2D recordings of
-//! `urgent_merge` (0 and 2 detail vehicles), `dense_merge` (0, 2 and all) and the default
-//! `platoon_merge_50` (113.6 MB): each vehicle at each logged instant (box, planned path, five
-//! time series) ≈ 950 B (≈ 620 B measured with 2 to 6 vehicles, ≈ 1.1 kB with 50), each
-//! potential-field snapshot (an RGBA image, compressed) ≈ 1.7 kB, each received shared path at
-//! each logged instant ≈ 120 B. It is within 20 % of the `dense_merge` and platoon recordings
-//! and overestimates the small urgent merge (~40 %); Rerun's own framing and compression make it
-//! an estimate, not a bound.
+//! A linear model in what is logged, refitted on 2026-12-02 to the recordings written since they
+//! are byte-identical (chunks of up to 256 rows or 256 KiB per entity, `rrd_writer`):
+//! `urgent_merge` (25 s; 0 and 2 detail vehicles: 570 737 and 872 694 B) and `dense_merge`
+//! (10 s; 0, 2 and all 6: 695 239, 1 033 381 and 1 636 872 B) (`merge_sim run --scenario S
+//! [--duration 10] --record-detail N --rrd F`): each vehicle at each logged instant (box, planned
+//! path, five time series) ≈ 570 B, each potential-field snapshot (an RGBA image, compressed)
+//! ≈ 1.65 kB, each received shared path at each logged instant ≈ 134 B. It is within 5 % of
+//! those recordings; it overestimates the default 50-vehicle platoon about 2.3 times (35.1 MB
+//! written: its 50 boxes share one row, and a vehicle receives only the paths in V2V range), so
+//! it errs on the side of the warning. Compression makes it an estimate, not a bound.
 
 use crate::config::{SimConfig, VehicleSpec};
 
 /// Bytes per vehicle and logged instant (box, planned path, time series).
-pub const BYTES_PER_VEHICLE_INSTANT: f64 = 950.0;
+pub const BYTES_PER_VEHICLE_INSTANT: f64 = 570.0;
 /// Bytes per potential-field snapshot.
-pub const BYTES_PER_FIELD: f64 = 1_700.0;
+pub const BYTES_PER_FIELD: f64 = 1_650.0;
 /// Bytes per received shared path and logged instant.
-pub const BYTES_PER_RECEIVED_PATH: f64 = 120.0;
+pub const BYTES_PER_RECEIVED_PATH: f64 = 134.0;
 
 /// The estimated size (bytes) of the recording of a run of `specs` with `config`, fields and
 /// received paths for the first `detail_vehicles` vehicles (`None`: all).

@@ -24,7 +24,7 @@ impl Recorder {
     }
 
     /// No-op (no recording can be open).
-    pub fn set_time(&self, _t_s: f64) -> Result<(), RecordingError> {
+    pub fn set_time(&mut self, _t_s: f64) -> Result<(), RecordingError> {
         Ok(())
     }
 
