@@ -314,8 +314,8 @@ impl Scenario {
                     field: Some(field),
                 };
             }
-            let field = sim_error_field(&e);
-            let nominal = field.as_deref().and_then(|f| self.nominal_path(f));
+            let nominal = sim_error_field(&e).and_then(|f| self.nominal_path(&f));
+            let field = sim_error_field(&e).map(|f| self.written_field(f));
             ScenarioError::Invalid {
                 origin: origin.to_string(),
                 line: at(entry.or(nominal)),

@@ -83,25 +83,41 @@ pub(crate) fn strip_driver_params(
             .get("vehicles")
             .and_then(|v| v.get_ref().get(i))
             .and_then(|v| v.get_ref().get("driver"));
+        // (key span, value span, end of the last value inside a `[vehicles.driver.params]`
+        // table written as a header).
         let entry = driver.and_then(|d| match d.get_ref() {
             DeValue::Table(t) => t
                 .iter()
                 .find(|(k, _)| k.get_ref().as_ref() == "params")
-                .map(|(k, v)| (k.span(), v.span())),
+                .map(|(k, v)| {
+                    let last_end = match v.get_ref() {
+                        DeValue::Table(inner) => inner
+                            .iter()
+                            .map(|(ik, iv)| ik.span().end.max(iv.span().end))
+                            .max(),
+                        _ => None,
+                    };
+                    (k.span(), v.span(), last_end)
+                }),
             _ => None,
         });
-        let inline = entry.as_ref().is_some_and(|(_, v)| text.as_bytes().get(v.start) == Some(&b'{'));
-        let (Some((key, value)), true) = (entry, inline) else {
+        let Some((key, value, last_end)) = entry else {
+            return Err(invalid(origin, Some(text), &[at], field, "cannot find it in the text".into()));
+        };
+        let line_start = text[..key.start].rfind('\n').map_or(0, |i| i + 1);
+        let inline = text.as_bytes().get(value.start) == Some(&b'{');
+        let header = text[line_start..].trim_start().starts_with('[');
+        if !inline && !header {
             return Err(invalid(
                 origin,
                 Some(text),
                 &[at],
                 field,
-                "write a vehicle's planner parameters inline: driver = { planner = \"NAME\", \
-                 params = { … } }"
+                "write a vehicle's planner parameters as an inline table (driver = { planner = \
+                 \"NAME\", params = { … } }) or under a [vehicles.driver.params] header"
                     .into(),
             ));
-        };
+        }
         let blank = |bytes: &mut Vec<u8>, from: usize, to: usize| {
             for b in &mut bytes[from..to] {
                 if *b != b'\n' && *b != b'\r' {
@@ -109,6 +125,13 @@ pub(crate) fn strip_driver_params(
                 }
             }
         };
+        if !inline {
+            // The header line and the table's entries, to the end of its last entry's line.
+            let end = last_end.unwrap_or(key.end).max(key.end);
+            let end = text[end..].find('\n').map_or(text.len(), |i| end + i);
+            blank(&mut bytes, line_start, end);
+            continue;
+        }
         blank(&mut bytes, key.start, value.end);
         // The comma that separated it from its neighbour inside the inline table.
         let before = text[..key.start].trim_end();
@@ -220,6 +243,22 @@ impl Scenario {
         match &self.source {
             Some(source) if line_of(&source.text, &new_form).is_some() => new_form,
             _ => path(&["sim", "planner", key]),
+        }
+    }
+
+    /// A simulator field as the file wrote it: `planner.KEY` is `planners.TABLE.KEY` when the
+    /// key is written in a `[sim.planners.TABLE]`.
+    pub(crate) fn written_field(&self, field: String) -> String {
+        match field.strip_prefix("planner.") {
+            Some(key) => {
+                let path = self.pf_key_path(key);
+                if path[1] == "planners" {
+                    format!("planners.{}.{key}", path[2])
+                } else {
+                    field
+                }
+            }
+            None => field,
         }
     }
 
