@@ -276,13 +276,30 @@ impl Scenario {
         text: Option<&str>,
     ) -> Result<(), ScenarioError> {
         self.sim.planner = planner_params_with_overrides(self.params, &self.planner_overrides)
-            .map_err(|message| ScenarioError::Invalid {
-                origin: origin.to_string(),
-                line: Line(
-                    text.and_then(|t| line_of(t, &["sim".to_string(), "planner".to_string()])),
-                ),
-                field: Some("sim.planner".into()),
-                message: format!("[sim.planner] on top of the {} set: {message}", self.params),
+            .map_err(|message| {
+                // The key that cannot be read: the first whose removal lets the rest be read.
+                let key = self.planner_overrides.keys().find(|key| {
+                    let mut rest = self.planner_overrides.clone();
+                    rest.remove(*key);
+                    planner_params_with_overrides(self.params, &rest).is_ok()
+                });
+                let (path, field) = match key {
+                    Some(key) => {
+                        let path = self.pf_key_path(key);
+                        let field = self.written_field(format!("planner.{key}"));
+                        (path, field)
+                    }
+                    None => (vec!["sim".to_string(), "planner".to_string()], "planner".into()),
+                };
+                ScenarioError::Invalid {
+                    origin: origin.to_string(),
+                    line: Line(text.and_then(|t| line_of(t, &path))),
+                    message: format!(
+                        "{field}: the planner values on top of the {} set: {message}",
+                        self.params
+                    ),
+                    field: Some(field),
+                }
             })?;
         Ok(())
     }

@@ -77,6 +77,19 @@ pub fn key_in_message(message: &str, table: &ParamsTable) -> Option<String> {
         .cloned()
 }
 
+/// The key of `written` whose value `T` cannot read (`table` = `written` on top of any base):
+/// the first whose removal lets `table` be read (a wrong type names no key in serde's message).
+pub fn fault_key<T: DeserializeOwned>(table: &ParamsTable, written: &ParamsTable) -> Option<String> {
+    written.keys().find_map(|key| {
+        let mut without = table.clone();
+        without.remove(key);
+        toml::Value::Table(without)
+            .try_into::<T>()
+            .is_ok()
+            .then(|| key.clone())
+    })
+}
+
 /// Reads `table` into a `P` and validates it.
 pub(crate) fn parse_typed<P: PlannerParameters>(
     table: &ParamsTable,
@@ -89,7 +102,7 @@ pub(crate) fn parse_typed<P: PlannerParameters>(
             .map_err(|e: toml::de::Error| {
                 let message = e.message().trim_end().to_string();
                 ParamsError {
-                    key: key_in_message(&message, table),
+                    key: key_in_message(&message, table).or_else(|| fault_key::<P>(table, table)),
                     message,
                 }
             })?

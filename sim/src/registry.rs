@@ -347,13 +347,18 @@ pub fn pf_params_with(base: &PlannerParams, keys: &ParamsTable) -> Result<Planne
     for (key, value) in keys {
         table.insert(key.clone(), value.clone());
     }
-    let params: PlannerParams = toml::Value::Table(table).try_into().map_err(|e: toml::de::Error| {
-        let message = e.message().trim_end().to_string();
-        ParamsError {
-            key: crate::planner_params::key_in_message(&message, keys),
-            message,
-        }
-    })?;
+    let params: PlannerParams =
+        toml::Value::Table(table.clone())
+            .try_into()
+            .map_err(|e: toml::de::Error| {
+                let message = e.message().trim_end().to_string();
+                ParamsError {
+                    key: crate::planner_params::key_in_message(&message, keys).or_else(|| {
+                        crate::planner_params::fault_key::<PlannerParams>(&table, keys)
+                    }),
+                    message,
+                }
+            })?;
     params.validate().map_err(|e| {
         let field = e
             .invalid_parameter()
