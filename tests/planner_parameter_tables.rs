@@ -13,8 +13,8 @@ use mergesim::experiment::{InstanceOptions, RunError, run_instance};
 use mergesim::scenarios::Scenario;
 use mergesim::sim::recording::Recorder;
 use mergesim::sim::{
-    Behaviour, BehaviourError, BehaviourRegistry, Decision, FactoryInput, Observation,
-    ParamsError, PathPoint, PlannerParameters, SimError,
+    Behaviour, BehaviourError, BehaviourRegistry, Decision, FactoryInput, Observation, ParamsError,
+    PathPoint, PlannerParameters, SimError,
 };
 
 const URGENT: &str = include_str!("../scenarios/builtin/urgent_merge.toml");
@@ -109,7 +109,10 @@ fn bad_planner_tables_exit_2_naming_file_line_and_field_with_nothing_written() {
             sweep.to_str().unwrap(),
         ]);
         assert_eq!(out.status.code(), Some(2), "{what}: {}", stderr(&out));
-        assert!(stderr(&out).contains(&format!("s.toml, line {line}")), "{what}");
+        assert!(
+            stderr(&out).contains(&format!("s.toml, line {line}")),
+            "{what}"
+        );
         assert!(!sweep.exists(), "{what}: a sweep summary was written");
     }
 }
@@ -270,8 +273,10 @@ fn a_user_planner_receives_its_table_and_each_vehicle_s_own_values() {
     let scenario = Scenario::from_toml(&bad, "s.toml").unwrap();
     let e = scenario.check_planners(&registry).unwrap_err().to_string();
     assert!(
-        e.starts_with(&format!("s.toml, line {}: ", line_of(&bad, "speed_mps = 70.0")))
-            && e.contains("vehicles[ego].driver.params.speed_mps"),
+        e.starts_with(&format!(
+            "s.toml, line {}: ",
+            line_of(&bad, "speed_mps = 70.0")
+        )) && e.contains("vehicles[ego].driver.params.speed_mps"),
         "{e}"
     );
     let e = run_instance(

@@ -193,7 +193,11 @@ mod tests {
         assert!(e.contains("belongs to pf-iso's table"), "{e}");
         let e = check_key("pf-iso", "risk_weight").unwrap_err();
         assert!(e.contains("belongs to pf-sp's table"), "{e}");
-        assert!(check_key("pf", "w3").unwrap_err().contains("unknown key `w3`"));
+        assert!(
+            check_key("pf", "w3")
+                .unwrap_err()
+                .contains("unknown key `w3`")
+        );
         assert!(check_vehicle_key(PlannerKind::PfIsoPred, "interaction_weight").is_ok());
         assert!(check_vehicle_key(PlannerKind::PfIso, "waypoint_count").is_ok());
         let e = check_vehicle_key(PlannerKind::PfCs, "risk_weight").unwrap_err();

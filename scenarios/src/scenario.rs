@@ -289,7 +289,10 @@ impl Scenario {
                         let field = self.written_field(format!("planner.{key}"));
                         (path, field)
                     }
-                    None => (vec!["sim".to_string(), "planner".to_string()], "planner".into()),
+                    None => (
+                        vec!["sim".to_string(), "planner".to_string()],
+                        "planner".into(),
+                    ),
                 };
                 ScenarioError::Invalid {
                     origin: origin.to_string(),

@@ -49,7 +49,10 @@ fn assert_refused(e: ScenarioError, line: usize, field: &str, words: &[&str]) {
         }
         other => panic!("not an Invalid error: {other:?}"),
     }
-    assert!(shown.starts_with(&format!("s.toml, line {line}: ")), "{shown}");
+    assert!(
+        shown.starts_with(&format!("s.toml, line {line}: ")),
+        "{shown}"
+    );
     for word in words {
         assert!(shown.contains(word), "{word:?} not in {shown}");
     }
@@ -84,7 +87,12 @@ fn the_pf_tables_are_views_on_the_one_parameter_struct_and_the_old_form_reads_th
 fn an_unknown_key_is_refused_with_file_line_and_field() {
     let text = text_with("[sim.planners.pf-iso]\nw3 = 1.0\n", None);
     let e = load(&text).unwrap_err();
-    assert_refused(e, line_of(&text, "w3 = "), "planners.pf-iso.w3", &["unknown key `w3`"]);
+    assert_refused(
+        e,
+        line_of(&text, "w3 = "),
+        "planners.pf-iso.w3",
+        &["unknown key `w3`"],
+    );
 }
 
 #[test]
@@ -98,7 +106,10 @@ fn a_key_of_another_planner_s_table_is_refused_naming_its_owner() {
         &["`interaction_weight` belongs to pf-iso's table"],
     );
     // A table named after a PF planner that reads another table.
-    let text = text_with("[sim.planners.pf-iso-pred]\ninteraction_weight = 6.0\n", None);
+    let text = text_with(
+        "[sim.planners.pf-iso-pred]\ninteraction_weight = 6.0\n",
+        None,
+    );
     let e = load(&text).unwrap_err();
     assert_refused(
         e,
@@ -124,7 +135,9 @@ fn an_out_of_range_value_in_a_pf_table_is_refused_at_its_line() {
 fn a_vehicle_s_params_give_its_planner_its_own_values() {
     let text = text_with(
         "[sim.planners.pf-iso]\ninteraction_weight = 9.0\n",
-        Some("driver = { planner = \"pf-iso\", params = { interaction_weight = 6.0, waypoint_count = 16 } }"),
+        Some(
+            "driver = { planner = \"pf-iso\", params = { interaction_weight = 6.0, waypoint_count = 16 } }",
+        ),
     );
     let scenario = load(&text).unwrap();
     // The scenario-level value stays the table's; the ego's own table is kept apart.
@@ -144,7 +157,10 @@ fn a_vehicle_s_params_give_its_planner_its_own_values() {
     assert_eq!(params.step_time_s, scenario.sim.planner.step_time_s);
     // Written back as TOML, it reads back the same.
     let again = load(&scenario.to_toml().unwrap()).unwrap();
-    assert_eq!(again.sim.vehicle_planner_params, scenario.sim.vehicle_planner_params);
+    assert_eq!(
+        again.sim.vehicle_planner_params,
+        scenario.sim.vehicle_planner_params
+    );
     assert_eq!(again.sim.planner, scenario.sim.planner);
 }
 
@@ -182,7 +198,12 @@ fn a_vehicle_s_bad_params_are_refused_at_their_line() {
     );
     let e = load(&text).unwrap_err();
     let line = line_of(&text, "params = { waypoint_count");
-    assert_refused(e, line, "vehicles[#0].driver.params", &["params go with a planner"]);
+    assert_refused(
+        e,
+        line,
+        "vehicles[#0].driver.params",
+        &["params go with a planner"],
+    );
 }
 
 /// A user's planner parameters.
@@ -198,7 +219,10 @@ impl PlannerParameters for CruiseParams {
         if (0.0..=100.0).contains(&self.gap_m) {
             Ok(())
         } else {
-            Err(ParamsError::at("gap_m", format!("{} m is outside [0, 100] m", self.gap_m)))
+            Err(ParamsError::at(
+                "gap_m",
+                format!("{} m is outside [0, 100] m", self.gap_m),
+            ))
         }
     }
 }
@@ -247,7 +271,12 @@ fn a_user_planner_s_table_is_read_by_its_own_type_and_checked_with_lines() {
     // Out of range in the scenario's table, then in the vehicle's.
     let bad = text.replace("gap_m = 12.0", "gap_m = 120.0");
     let e = load(&bad).unwrap().check_planners(&registry).unwrap_err();
-    assert_refused(e, line_of(&bad, "gap_m = 120.0"), "planners.cruise.gap_m", &["outside [0, 100]"]);
+    assert_refused(
+        e,
+        line_of(&bad, "gap_m = 120.0"),
+        "planners.cruise.gap_m",
+        &["outside [0, 100]"],
+    );
     let bad = text.replace("gap_m = 30.0", "gap_m = -1.0");
     let e = load(&bad).unwrap().check_planners(&registry).unwrap_err();
     assert_refused(
@@ -259,7 +288,12 @@ fn a_user_planner_s_table_is_read_by_its_own_type_and_checked_with_lines() {
     // An unknown key.
     let bad = text.replace("label = ", "lable = ");
     let e = load(&bad).unwrap().check_planners(&registry).unwrap_err();
-    assert_refused(e, line_of(&bad, "lable = "), "planners.cruise.lable", &["lable"]);
+    assert_refused(
+        e,
+        line_of(&bad, "lable = "),
+        "planners.cruise.lable",
+        &["lable"],
+    );
     // A table for a planner that is not registered.
     let e = scenario
         .check_planners(&BehaviourRegistry::builtin())
@@ -278,7 +312,10 @@ fn params_for_a_planner_registered_without_a_type_are_refused_naming_it() {
         "",
         Some("driver = { planner = \"bare\", params = { speed_mps = 3.0 } }"),
     );
-    let e = load(&text).unwrap().check_planners(&user_registry()).unwrap_err();
+    let e = load(&text)
+        .unwrap()
+        .check_planners(&user_registry())
+        .unwrap_err();
     assert_refused(
         e,
         line_of(&text, "speed_mps = 3.0"),
@@ -286,7 +323,10 @@ fn params_for_a_planner_registered_without_a_type_are_refused_naming_it() {
         &["planner bare takes no parameters"],
     );
     let text = text_with("[sim.planners.bare]\nspeed_mps = 3.0\n", None);
-    let e = load(&text).unwrap().check_planners(&user_registry()).unwrap_err();
+    let e = load(&text)
+        .unwrap()
+        .check_planners(&user_registry())
+        .unwrap_err();
     assert_refused(
         e,
         line_of(&text, "speed_mps = 3.0"),

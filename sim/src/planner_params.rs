@@ -79,7 +79,10 @@ pub fn key_in_message(message: &str, table: &ParamsTable) -> Option<String> {
 
 /// The key of `written` whose value `T` cannot read (`table` = `written` on top of any base):
 /// the first whose removal lets `table` be read (a wrong type names no key in serde's message).
-pub fn fault_key<T: DeserializeOwned>(table: &ParamsTable, written: &ParamsTable) -> Option<String> {
+pub fn fault_key<T: DeserializeOwned>(
+    table: &ParamsTable,
+    written: &ParamsTable,
+) -> Option<String> {
     written.keys().find_map(|key| {
         let mut without = table.clone();
         without.remove(key);
@@ -125,7 +128,10 @@ mod tests {
             if (0.0..=10.0).contains(&self.gain) {
                 Ok(())
             } else {
-                Err(ParamsError::at("gain", format!("{} is outside [0, 10]", self.gain)))
+                Err(ParamsError::at(
+                    "gain",
+                    format!("{} is outside [0, 10]", self.gain),
+                ))
             }
         }
     }

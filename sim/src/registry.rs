@@ -341,9 +341,14 @@ impl BehaviourRegistry {
 }
 
 /// `base` with the values of `keys` on top, validated; the error names the key.
-pub fn pf_params_with(base: &PlannerParams, keys: &ParamsTable) -> Result<PlannerParams, ParamsError> {
-    let mut table = ParamsTable::try_from(base)
-        .map_err(|e| ParamsError { key: None, message: e.to_string() })?;
+pub fn pf_params_with(
+    base: &PlannerParams,
+    keys: &ParamsTable,
+) -> Result<PlannerParams, ParamsError> {
+    let mut table = ParamsTable::try_from(base).map_err(|e| ParamsError {
+        key: None,
+        message: e.to_string(),
+    })?;
     for (key, value) in keys {
         table.insert(key.clone(), value.clone());
     }

@@ -22,7 +22,13 @@ fn path(parts: &[&str]) -> Vec<String> {
     parts.iter().map(|p| p.to_string()).collect()
 }
 
-fn invalid(origin: &str, text: Option<&str>, at: &[Vec<String>], field: String, message: String) -> ScenarioError {
+fn invalid(
+    origin: &str,
+    text: Option<&str>,
+    at: &[Vec<String>],
+    field: String,
+    message: String,
+) -> ScenarioError {
     let line = text.and_then(|t| at.iter().find_map(|p| line_of(t, p)));
     ScenarioError::Invalid {
         origin: origin.to_string(),
@@ -54,7 +60,13 @@ pub(crate) fn strip_driver_params(
         let at = path(&["vehicles", &i.to_string(), "driver", "params"]);
         let field = format!("vehicles[#{i}].driver.params");
         let Some(params) = params.as_table() else {
-            return Err(invalid(origin, Some(text), &[at], field, "must be a table of the planner's parameters".into()));
+            return Err(invalid(
+                origin,
+                Some(text),
+                &[at],
+                field,
+                "must be a table of the planner's parameters".into(),
+            ));
         };
         if !driver.get("planner").is_some_and(|p| p.is_str()) {
             return Err(invalid(
@@ -102,7 +114,13 @@ pub(crate) fn strip_driver_params(
             _ => None,
         });
         let Some((key, value, last_end)) = entry else {
-            return Err(invalid(origin, Some(text), &[at], field, "cannot find it in the text".into()));
+            return Err(invalid(
+                origin,
+                Some(text),
+                &[at],
+                field,
+                "cannot find it in the text".into(),
+            ));
         };
         let line_start = text[..key.start].rfind('\n').map_or(0, |i| i + 1);
         let inline = text.as_bytes().get(value.start) == Some(&b'{');
@@ -230,7 +248,9 @@ impl Scenario {
                 ));
             }
         }
-        self.sim.planners.retain(|name, _| !PF_TABLES.contains(&name.as_str()));
+        self.sim
+            .planners
+            .retain(|name, _| !PF_TABLES.contains(&name.as_str()));
         self.planner_overrides = overrides;
         Ok(())
     }
@@ -347,7 +367,13 @@ impl Scenario {
                         format!("vehicles[{}].driver.params", vehicle.name),
                     ),
                 };
-                invalid(&origin, text, &at, field, format!("planner {name}: {}", e.message))
+                invalid(
+                    &origin,
+                    text,
+                    &at,
+                    field,
+                    format!("planner {name}: {}", e.message),
+                )
             };
             if !registry.contains(name) {
                 if skip_unknown {
