@@ -113,6 +113,9 @@ impl FactoryInput<'_> {
 pub type BehaviourFactory =
     Arc<dyn Fn(&FactoryInput<'_>) -> Result<Box<dyn Behaviour>, SimError> + Send + Sync>;
 
+/// Reads a table into a planner's parameter type and validates it.
+type ParseParams = Arc<dyn Fn(&ParamsTable) -> Result<ParsedParams, ParamsError> + Send + Sync>;
+
 /// How a planner's parameter tables are read (module doc).
 #[derive(Clone)]
 enum Schema {
@@ -121,7 +124,7 @@ enum Schema {
     /// A built-in potential-field planner: the tables are views on `PlannerParams`.
     Pf(PlannerKind),
     /// A user's parameter type.
-    Typed(Arc<dyn Fn(&ParamsTable) -> Result<ParsedParams, ParamsError> + Send + Sync>),
+    Typed(ParseParams),
 }
 
 /// Planner names → factories and parameter schemas (module doc). Names are kept sorted, so
