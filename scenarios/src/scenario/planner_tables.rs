@@ -376,10 +376,7 @@ impl Scenario {
                 )
             };
             if !registry.contains(name) {
-                if skip_unknown {
-                    continue;
-                }
-                // The run refuses the unknown planner itself (`SimError::UnknownPlanner`).
+                // The run refuses an unknown planner itself (`SimError::UnknownPlanner`).
                 continue;
             }
             if let Some(kind) = registry.pf_kind(name) {
