@@ -24,6 +24,7 @@ pub mod obstacle_field;
 pub mod others;
 pub mod parameter_set;
 pub mod params;
+pub mod params_tables;
 pub mod planners;
 pub mod polyline;
 pub mod potential_field;

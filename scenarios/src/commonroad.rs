@@ -430,6 +430,7 @@ impl Scenario {
             vehicles: vec![ego],
             randomise: crate::Randomisation::default(),
             planner_overrides: toml::Table::new(),
+            source: None,
         };
         scenario.apply_parameter_set(&origin, None)?;
         scenario.check(&origin, None)?;

@@ -20,4 +20,4 @@ pub mod source_location;
 
 pub use distribution::{Distribution, NormalOffset};
 pub use randomisation::{Randomisation, VehicleRandomisation};
-pub use scenario::{Scenario, ScenarioError};
+pub use scenario::{Scenario, ScenarioError, ScenarioSource};

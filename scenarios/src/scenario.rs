@@ -2,6 +2,7 @@
 
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use planner::{Lane, ParameterSet, PlannerParams};
 use serde::{Deserialize, Serialize};
@@ -35,9 +36,31 @@ pub struct Scenario {
     /// Randomisation ranges for sweeps and `run --seed` (empty: every instance is nominal).
     #[serde(default, skip_serializing_if = "Randomisation::is_empty")]
     pub randomise: Randomisation,
-    /// The `[sim.planner]` values the file sets (applied on top of `params`).
+    /// The PF planners' values the file sets (`[sim.planner]` and `[sim.planners.pf]`,
+    /// `[sim.planners.pf-iso]`, `[sim.planners.pf-sp]`, merged; applied on top of `params`).
     #[serde(skip)]
     pub planner_overrides: toml::Table,
+    /// The file and text the scenario was read from, for the lines of checks made after
+    /// loading ([`Scenario::check_planners`]); `None` for a scenario built in code.
+    #[serde(skip)]
+    pub source: Option<Arc<ScenarioSource>>,
+}
+
+/// Where a scenario was read from (its origin and TOML text).
+#[derive(Clone, Debug)]
+pub struct ScenarioSource {
+    /// File name or `built-in NAME`.
+    pub origin: String,
+    /// The TOML text as read.
+    pub text: String,
+}
+
+/// Where a scenario was read from is not part of what it is: two scenarios compare equal
+/// whatever their sources.
+impl PartialEq for ScenarioSource {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// The planner parameters of `set` with `overrides` (a `[sim.planner]` table) on top.
@@ -184,6 +207,12 @@ impl Scenario {
             message: e.to_string().trim_end().to_string(),
         };
         let table: toml::Table = toml::from_str(text).map_err(parse_error)?;
+        // A vehicle's `driver = { planner = …, params = { … } }` (planner_tables.rs): the
+        // typed reading sees the text without its `params`.
+        let (without_params, vehicle_params) =
+            planner_tables::strip_driver_params(&table, text, origin)?;
+        let full_text = text;
+        let text = without_params.as_str();
         // `[sim.road] commonroad = …` (commonroad_toml.rs): read without those keys.
         let source = crate::commonroad_toml::road_source(&table, text, origin)?;
         let stripped;
@@ -207,20 +236,24 @@ impl Scenario {
         }
         // `[sim.lane_road] opendrive = { file = … }`: read once, relative to the TOML.
         crate::opendrive_source::read_opendrive_source(&mut scenario, base, origin, Some(text))?;
-        // The [sim.planner] values as written, to apply on top of the parameter set.
-        scenario.planner_overrides = table
-            .get("sim")
-            .and_then(|sim| sim.get("planner"))
-            .and_then(|planner| planner.as_table())
-            .cloned()
-            .unwrap_or_default();
-        scenario.apply_parameter_set(origin, Some(text))?;
+        // The PF planners' tables as written, to apply on top of the parameter set; a
+        // vehicle's own parameters by its name.
+        scenario.set_source(origin, full_text);
+        scenario.take_pf_tables(&table, origin, full_text)?;
+        for (i, params) in vehicle_params {
+            if let Some(vehicle) = scenario.vehicles.get(i) {
+                let name = vehicle.name.clone();
+                scenario.sim.vehicle_planner_params.insert(name, params);
+            }
+        }
+        scenario.apply_parameter_set(origin, Some(full_text))?;
         if source.is_none() {
             lane_road_checks::check_one_road(&table, &scenario, origin, text)?;
         }
         scenario
             .check(origin, Some(text))
             .map_err(|e| crate::commonroad_toml::aliased(e, &scenario, &table, text))?;
+        scenario.check_planner_tables(&sim::BehaviourRegistry::builtin(), true)?;
         Ok(scenario)
     }
 
@@ -232,6 +265,7 @@ impl Scenario {
         let origin = format!("{} with --params {set}", self.name);
         scenario.apply_parameter_set(&origin, None)?;
         scenario.check(&origin, None)?;
+        scenario.check_planner_tables(&sim::BehaviourRegistry::builtin(), true)?;
         Ok(scenario)
     }
 
@@ -242,13 +276,33 @@ impl Scenario {
         text: Option<&str>,
     ) -> Result<(), ScenarioError> {
         self.sim.planner = planner_params_with_overrides(self.params, &self.planner_overrides)
-            .map_err(|message| ScenarioError::Invalid {
-                origin: origin.to_string(),
-                line: Line(
-                    text.and_then(|t| line_of(t, &["sim".to_string(), "planner".to_string()])),
-                ),
-                field: Some("sim.planner".into()),
-                message: format!("[sim.planner] on top of the {} set: {message}", self.params),
+            .map_err(|message| {
+                // The key that cannot be read: the first whose removal lets the rest be read.
+                let key = self.planner_overrides.keys().find(|key| {
+                    let mut rest = self.planner_overrides.clone();
+                    rest.remove(*key);
+                    planner_params_with_overrides(self.params, &rest).is_ok()
+                });
+                let (path, field) = match key {
+                    Some(key) => {
+                        let path = self.pf_key_path(key);
+                        let field = self.written_field(format!("planner.{key}"));
+                        (path, field)
+                    }
+                    None => (
+                        vec!["sim".to_string(), "planner".to_string()],
+                        "planner".into(),
+                    ),
+                };
+                ScenarioError::Invalid {
+                    origin: origin.to_string(),
+                    line: Line(text.and_then(|t| line_of(t, &path))),
+                    message: format!(
+                        "{field}: the planner values on top of the {} set: {message}",
+                        self.params
+                    ),
+                    field: Some(field),
+                }
             })?;
         Ok(())
     }
@@ -280,8 +334,8 @@ impl Scenario {
                     field: Some(field),
                 };
             }
-            let field = sim_error_field(&e);
-            let nominal = field.as_deref().and_then(|f| self.nominal_path(f));
+            let nominal = sim_error_field(&e).and_then(|f| self.nominal_path(&f));
+            let field = sim_error_field(&e).map(|f| self.written_field(f));
             ScenarioError::Invalid {
                 origin: origin.to_string(),
                 line: at(entry.or(nominal)),
@@ -509,6 +563,9 @@ impl Scenario {
                 first.to_string(),
             ]);
         }
+        if let Some(key) = field.strip_prefix("planner.") {
+            return Some(self.pf_key_path(key));
+        }
         let mut path = vec!["sim".to_string()];
         path.extend(field.split('.').map(str::to_string));
         Some(path)
@@ -548,6 +605,17 @@ impl Scenario {
                 sim.insert("planner".into(), toml::Value::Table(differing));
             }
         }
+        // Each vehicle's own planner parameters, back in its driver table.
+        if let Some(vehicles) = table.get_mut("vehicles").and_then(|v| v.as_array_mut()) {
+            for (vehicle, spec) in vehicles.iter_mut().zip(&self.vehicles) {
+                let Some(params) = self.sim.vehicle_planner_params.get(&spec.name) else {
+                    continue;
+                };
+                if let Some(driver) = vehicle.get_mut("driver").and_then(|d| d.as_table_mut()) {
+                    driver.insert("params".into(), toml::Value::Table(params.clone()));
+                }
+            }
+        }
         toml::to_string(&table).map_err(|e| error(e.to_string()))
     }
 
@@ -565,6 +633,7 @@ impl Scenario {
             vehicles,
             randomise: Randomisation::default(),
             planner_overrides: self.planner_overrides.clone(),
+            source: self.source.clone(),
         }
     }
 
@@ -590,5 +659,6 @@ fn split_vehicle_field(field: &str) -> Option<(&str, &str)> {
 }
 
 mod lane_road_checks;
+mod planner_tables;
 #[cfg(test)]
 mod tests;

@@ -9,6 +9,7 @@ use vehicles::{Tracker, Vehicle, VehicleParams};
 use crate::config::{Driver, SimConfig, VehicleSpec};
 use crate::drivers::{IdmDriver, LaneKeeping, PrescribedSpeed};
 use crate::error::SimError;
+use crate::planner_params::{ParamsError, ParamsTable, ParsedParams};
 use crate::registry::{BehaviourRegistry, FactoryInput};
 
 /// One vehicle and its driver.
@@ -43,20 +44,47 @@ pub fn behaviour_of(
     planner_override: Option<&str>,
     lanes: &std::sync::Arc<mergesim_types::lanes::LaneRoad>,
 ) -> Result<Box<dyn Behaviour>, SimError> {
-    let input = FactoryInput {
-        config,
-        spec,
-        lanes,
+    // The planner's own parameters (`crate::planner_params`): its scenario table overlaid by
+    // the vehicle's `driver.params`, read by its schema.
+    let vehicle_params = config.vehicle_planner_params.get(&spec.name);
+    let params_of = |name: &str, own: Option<&ParamsTable>| {
+        registry
+            .parse_params(name, config, own)
+            .map_err(|e| params_error(config, spec, name, own, e))
+    };
+    let create = |name: &str, params: Option<&ParsedParams>| {
+        let input = FactoryInput {
+            config,
+            spec,
+            lanes,
+            params: params.map(|p| p.as_ref() as &(dyn std::any::Any + Send + Sync)),
+        };
+        registry.create(name, &input)
     };
     Ok(match &spec.driver {
-        Driver::Planner(name) => registry.create(planner_override.unwrap_or(name), &input)?,
+        Driver::Planner(name) => {
+            let name = planner_override.unwrap_or(name);
+            let params = if registry.contains(name) {
+                params_of(name, vehicle_params)?
+            } else {
+                None // `create` names the unknown planner
+            };
+            create(name, params.as_ref())?
+        }
         Driver::Prescribed {
             path_planner,
             speed_profile,
-        } => Box::new(PrescribedSpeed {
-            path_planner: registry.create(path_planner, &input)?,
-            profile: speed_profile.clone(),
-        }),
+        } => {
+            let params = if registry.contains(path_planner) {
+                params_of(path_planner, None)?
+            } else {
+                None
+            };
+            Box::new(PrescribedSpeed {
+                path_planner: create(path_planner, params.as_ref())?,
+                profile: speed_profile.clone(),
+            })
+        }
         Driver::LaneKeeping => Box::new(LaneKeeping {
             lane: spec.lane.id(),
             d_offset_m: spec.y_offset_m,
@@ -67,6 +95,33 @@ pub fn behaviour_of(
             d_offset_m: spec.y_offset_m,
         }),
     })
+}
+
+/// A refused parameter table as a simulator error naming the field: the vehicle's
+/// `driver.params.KEY` if its own table holds the key, else `planners.NAME.KEY`.
+fn params_error(
+    config: &SimConfig,
+    spec: &VehicleSpec,
+    planner: &str,
+    own: Option<&ParamsTable>,
+    e: ParamsError,
+) -> SimError {
+    let in_own = e
+        .key
+        .as_ref()
+        .is_some_and(|k| own.is_some_and(|t| t.contains_key(k)));
+    let key_suffix = e.key.as_ref().map(|k| format!(".{k}")).unwrap_or_default();
+    let field = if in_own {
+        format!("vehicles[{}].driver.params{key_suffix}", spec.name)
+    } else if config.planners.contains_key(planner) {
+        format!("planners.{planner}{key_suffix}")
+    } else {
+        format!("vehicles[{}].driver.params{key_suffix}", spec.name)
+    };
+    SimError::InvalidField {
+        field,
+        message: format!("planner {planner}: {}", e.message),
+    }
 }
 
 impl Agent {

@@ -1,5 +1,7 @@
 //! What a simulation is made of: the shared settings and the vehicles to spawn.
 
+use std::collections::BTreeMap;
+
 use planner::{MergeRoad, PlannerParams, SpeedProfile};
 use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
@@ -10,6 +12,7 @@ use mergesim_types::{Bound, bounds};
 use crate::error::SimError;
 use crate::goal::Goal;
 use crate::idm::IdmParams;
+use crate::planner_params::ParamsTable;
 use crate::recorded_traffic::RecordedTraffic;
 use crate::road_config::{LaneRoadConfig, StartLane, build_lane_road};
 use crate::safety::SafetyParams;
@@ -44,8 +47,22 @@ pub struct SimConfig {
     pub perception_range_m: f64,
     /// V2V bus.
     pub v2v: V2vParams,
-    /// Planner parameters (every PF vehicle).
+    /// The potential-field planners' parameters, scenario level: the `--params` set's with the
+    /// `[sim.planners.pf]` (alias `[sim.planner]`), `[sim.planners.pf-iso]` and
+    /// `[sim.planners.pf-sp]` tables on top (the scenario loader merges them;
+    /// `planner::params_tables`). A vehicle's `driver = { params = … }` gives its own planner
+    /// its own copy ([`SimConfig::vehicle_planner_params`]); everything else that reads this
+    /// (V2V horizon, metrics, the field images, …) reads this scenario-level value.
     pub planner: PlannerParams,
+    /// Each other planner's own table, by registered name (`[sim.planners.NAME]`): read by the
+    /// planner's schema when its vehicles are built (`crate::planner_params`).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub planners: BTreeMap<String, ParamsTable>,
+    /// A vehicle's own planner parameters (`driver = { planner = "NAME", params = { … } }`),
+    /// by vehicle name, overlaying the scenario's table of that planner key by key: filled by
+    /// the scenario loader, never written under `[sim]`.
+    #[serde(skip)]
+    pub vehicle_planner_params: BTreeMap<String, ParamsTable>,
     /// Path / speed tracker.
     pub tracker: TrackerParams,
     /// Collision, gap and TTC thresholds.
@@ -73,6 +90,8 @@ impl Default for SimConfig {
             perception_range_m: DEFAULT_PERCEPTION_RANGE_M,
             v2v: V2vParams::default(),
             planner: PlannerParams::default(),
+            planners: BTreeMap::new(),
+            vehicle_planner_params: BTreeMap::new(),
             tracker: TrackerParams::default(),
             safety: SafetyParams::default(),
             idm: IdmParams::default(),

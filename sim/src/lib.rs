@@ -16,6 +16,7 @@ pub mod metrics;
 pub mod observer;
 pub mod outcome;
 pub mod paper_metrics;
+pub mod planner_params;
 pub mod profile;
 pub mod recorded_motion;
 pub mod recorded_traffic;
@@ -45,6 +46,7 @@ pub use mergesim_types::{
 };
 pub use observer::{PlanView, TickObserver, VehicleView};
 pub use outcome::{PlannerStats, RecordedPose, RunOutcome, TimeSeriesRow};
+pub use planner_params::{ParamsError, ParamsTable, PlannerParameters};
 pub use registry::{BehaviourFactory, BehaviourRegistry, FactoryInput};
 pub use road_config::{CommonRoadRoad, LaneRoadConfig, StartLane};
 pub use world::{RunOptions, World};

@@ -31,14 +31,59 @@
 //!     .unwrap();
 //! assert!(registry.names().contains(&"cruise"));
 //! ```
+//!
+//! A planner with parameters registers its parameter type with
+//! [`BehaviourRegistry::register_with_params`]: its `[sim.planners.NAME]` table, overlaid by a
+//! vehicle's `driver = { planner = "NAME", params = { … } }`, is read into that type, checked
+//! by its [`PlannerParameters::validate`] and handed to the factory (`crate::planner_params`).
+//! A planner registered with [`BehaviourRegistry::register`] takes no parameters: a non-empty
+//! table for it is refused, naming it.
+//!
+//! ```
+//! use std::sync::Arc;
+//! use sim::registry::{BehaviourRegistry, FactoryInput};
+//! use sim::{Behaviour, BehaviourError, Decision, Observation, ParamsError, PlannerParameters};
+//!
+//! #[derive(Debug, Default, serde::Deserialize)]
+//! #[serde(deny_unknown_fields, default)]
+//! struct CruiseParams {
+//!     /// Spacing of the path's points (m).
+//!     spacing_m: f64,
+//! }
+//! impl PlannerParameters for CruiseParams {
+//!     fn validate(&self) -> Result<(), ParamsError> {
+//!         if self.spacing_m > 0.0 && self.spacing_m <= 50.0 {
+//!             Ok(())
+//!         } else {
+//!             Err(ParamsError::at("spacing_m", "must lie in (0, 50] m"))
+//!         }
+//!     }
+//! }
+//! # struct Cruise(f64);
+//! # impl Behaviour for Cruise {
+//! #     fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError> {
+//! #         unimplemented!()
+//! #     }
+//! # }
+//! let mut registry = BehaviourRegistry::builtin();
+//! registry
+//!     .register_with_params("cruise", |_: &FactoryInput<'_>, p: &CruiseParams| {
+//!         Ok(Box::new(Cruise(p.spacing_m)) as Box<dyn Behaviour>)
+//!     })
+//!     .unwrap();
+//! ```
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use planner::{PfPlanner, PlannerKind};
+use planner::params_tables::{self, PF_TABLES};
+use planner::{PfPlanner, PlannerKind, PlannerParams};
 
 use crate::config::{SimConfig, VehicleSpec};
 use crate::error::SimError;
+use crate::planner_params::{
+    ParamsError, ParamsTable, ParsedParams, PlannerParameters, overlay, parse_typed,
+};
 use mergesim_types::Behaviour;
 
 /// What a factory gets to build one vehicle's behaviour.
@@ -50,17 +95,44 @@ pub struct FactoryInput<'a> {
     pub spec: &'a VehicleSpec,
     /// The road as lanes, built once per world (the road every `Observation::lanes` carries).
     pub lanes: &'a Arc<mergesim_types::lanes::LaneRoad>,
+    /// The vehicle's planner parameters, parsed and validated by the planner's schema (module
+    /// doc): a `P` for a planner registered with `register_with_params::<P>`; for a built-in PF
+    /// planner a `planner::PlannerParams` when the vehicle has its own (`None`: the
+    /// scenario's `config.planner`); `None` for a planner without parameters.
+    pub params: Option<&'a (dyn std::any::Any + Send + Sync)>,
+}
+
+impl FactoryInput<'_> {
+    /// The parameters as a `P` (None if there are none, or they are not a `P`).
+    pub fn params_as<P: 'static>(&self) -> Option<&P> {
+        self.params.and_then(|p| p.downcast_ref::<P>())
+    }
 }
 
 /// Builds a behaviour for one vehicle.
 pub type BehaviourFactory =
     Arc<dyn Fn(&FactoryInput<'_>) -> Result<Box<dyn Behaviour>, SimError> + Send + Sync>;
 
-/// Planner names → factories (module doc). Names are kept sorted, so listing them is
-/// deterministic.
+/// Reads a table into a planner's parameter type and validates it.
+type ParseParams = Arc<dyn Fn(&ParamsTable) -> Result<ParsedParams, ParamsError> + Send + Sync>;
+
+/// How a planner's parameter tables are read (module doc).
+#[derive(Clone)]
+enum Schema {
+    /// Registered without parameters: any non-empty table is refused.
+    None,
+    /// A built-in potential-field planner: the tables are views on `PlannerParams`.
+    Pf(PlannerKind),
+    /// A user's parameter type.
+    Typed(ParseParams),
+}
+
+/// Planner names → factories and parameter schemas (module doc). Names are kept sorted, so
+/// listing them is deterministic.
 #[derive(Clone, Default)]
 pub struct BehaviourRegistry {
     factories: BTreeMap<String, BehaviourFactory>,
+    schemas: BTreeMap<String, Schema>,
 }
 
 impl std::fmt::Debug for BehaviourRegistry {
@@ -74,7 +146,11 @@ impl std::fmt::Debug for BehaviourRegistry {
 /// The factory of a potential-field planner of `kind`.
 fn pf_factory(kind: PlannerKind) -> BehaviourFactory {
     Arc::new(move |input: &FactoryInput<'_>| {
-        PfPlanner::new(kind, input.config.planner.clone(), Arc::clone(input.lanes))
+        let params = input
+            .params_as::<PlannerParams>()
+            .unwrap_or(&input.config.planner)
+            .clone();
+        PfPlanner::new(kind, params, Arc::clone(input.lanes))
             .map(|p| match &input.spec.route {
                 Some(route) => p.with_route(route),
                 None => p,
@@ -100,13 +176,56 @@ impl BehaviourRegistry {
             registry
                 .factories
                 .insert(kind.name().to_string(), pf_factory(kind));
+            registry
+                .schemas
+                .insert(kind.name().to_string(), Schema::Pf(kind));
         }
         registry
     }
 
     /// Adds `factory` under `name`. Refuses an empty name, one with whitespace, commas or
     /// quotes, and a name already taken (a built-in cannot be replaced by accident).
+    /// It takes no parameters: a non-empty `[sim.planners.NAME]` or `driver.params` table for it
+    /// is refused.
     pub fn register(&mut self, name: &str, factory: BehaviourFactory) -> Result<(), SimError> {
+        self.insert(name, factory, Schema::None)
+    }
+
+    /// Adds `factory` under `name` with its parameter type `P` (module doc): the factory gets
+    /// the vehicle's parameters, `[sim.planners.NAME]` overlaid by its `driver.params`, read
+    /// into a `P` and validated. Refuses names as [`BehaviourRegistry::register`] does.
+    pub fn register_with_params<P, F>(&mut self, name: &str, factory: F) -> Result<(), SimError>
+    where
+        P: PlannerParameters,
+        F: Fn(&FactoryInput<'_>, &P) -> Result<Box<dyn Behaviour>, SimError>
+            + Send
+            + Sync
+            + 'static,
+    {
+        let planner = name.to_string();
+        let wrapped: BehaviourFactory = Arc::new(move |input: &FactoryInput<'_>| {
+            // `behaviour_of` always passes the parsed value; a caller building its own input
+            // without one gets the table's defaults.
+            match input.params_as::<P>() {
+                Some(params) => factory(input, params),
+                None => factory(input, &P::default()),
+            }
+            .map_err(|e| match e {
+                SimError::InvalidScenario(message) => {
+                    SimError::InvalidScenario(format!("planner {planner}: {message}"))
+                }
+                other => other,
+            })
+        });
+        self.insert(name, wrapped, Schema::Typed(Arc::new(parse_typed::<P>)))
+    }
+
+    fn insert(
+        &mut self,
+        name: &str,
+        factory: BehaviourFactory,
+        schema: Schema,
+    ) -> Result<(), SimError> {
         if name.is_empty() || name.contains(|c: char| c.is_whitespace() || c == ',' || c == '"') {
             return Err(SimError::InvalidScenario(format!(
                 "planner name {name:?} must be non-empty, without spaces, commas or quotes"
@@ -118,7 +237,82 @@ impl BehaviourRegistry {
             )));
         }
         self.factories.insert(name.to_string(), factory);
+        self.schemas.insert(name.to_string(), schema);
         Ok(())
+    }
+
+    /// The kind of a built-in potential-field planner registered as `name` (its tables are
+    /// views on `PlannerParams`, `planner::params_tables`).
+    pub fn pf_kind(&self, name: &str) -> Option<PlannerKind> {
+        match self.schemas.get(name) {
+            Some(Schema::Pf(kind)) => Some(*kind),
+            _ => None,
+        }
+    }
+
+    /// Whether `name` was registered with a parameter type (or is a built-in PF planner).
+    pub fn has_params(&self, name: &str) -> bool {
+        !matches!(self.schemas.get(name), None | Some(Schema::None))
+    }
+
+    /// The parameters of planner `name` for one vehicle: `[sim.planners.NAME]` of `config`
+    /// overlaid by the vehicle's own `vehicle` table, read and checked by the planner's schema
+    /// (module doc). `Ok(None)`: the planner takes none (or, for a PF planner, the vehicle has
+    /// none of its own and uses `config.planner`). The error names the key; it is in
+    /// `vehicle` if that table holds it, else in the scenario's table.
+    pub fn parse_params(
+        &self,
+        name: &str,
+        config: &SimConfig,
+        vehicle: Option<&ParamsTable>,
+    ) -> Result<Option<ParsedParams>, ParamsError> {
+        let scenario = config.planners.get(name);
+        match self.schemas.get(name).unwrap_or(&Schema::None) {
+            Schema::None => {
+                let written = overlay(scenario, vehicle);
+                match written.keys().next() {
+                    None => Ok(None),
+                    Some(key) => Err(ParamsError::at(
+                        key.clone(),
+                        format!(
+                            "planner {name} takes no parameters (it was registered without a                              parameter type: register it with register_with_params)"
+                        ),
+                    )),
+                }
+            }
+            Schema::Typed(parse) => parse(&overlay(scenario, vehicle)).map(Some),
+            Schema::Pf(_) => {
+                // The PF tables a program may put in `planners` (the loader merges them into
+                // `config.planner`), then the vehicle's keys: all views on one PlannerParams.
+                let mut keys = ParamsTable::new();
+                for table_name in PF_TABLES {
+                    if let Some(table) = config.planners.get(table_name) {
+                        for key in table.keys() {
+                            params_tables::check_key(table_name, key)
+                                .map_err(|m| ParamsError::at(key.clone(), m))?;
+                        }
+                        keys = overlay(Some(&keys), Some(table));
+                    }
+                }
+                for key in vehicle.into_iter().flat_map(|v| v.keys()) {
+                    // Any PF field: under `--planner` a vehicle's values go with it to another
+                    // PF planner (its own table's keys then have no effect there).
+                    if params_tables::table_of_field(key).is_none() {
+                        return Err(ParamsError::at(
+                            key.clone(),
+                            params_tables::check_key(params_tables::PF_TABLE, key)
+                                .err()
+                                .unwrap_or_default(),
+                        ));
+                    }
+                }
+                let keys = overlay(Some(&keys), vehicle);
+                if keys.is_empty() {
+                    return Ok(None);
+                }
+                pf_params_with(&config.planner, &keys).map(|p| Some(Arc::new(p) as ParsedParams))
+            }
+        }
     }
 
     /// Every registered name, sorted.
@@ -147,6 +341,42 @@ impl BehaviourRegistry {
             })?;
         factory(input)
     }
+}
+
+/// `base` with the values of `keys` on top, validated; the error names the key.
+pub fn pf_params_with(
+    base: &PlannerParams,
+    keys: &ParamsTable,
+) -> Result<PlannerParams, ParamsError> {
+    let mut table = ParamsTable::try_from(base).map_err(|e| ParamsError {
+        key: None,
+        message: e.to_string(),
+    })?;
+    for (key, value) in keys {
+        table.insert(key.clone(), value.clone());
+    }
+    let params: PlannerParams =
+        toml::Value::Table(table.clone())
+            .try_into()
+            .map_err(|e: toml::de::Error| {
+                let message = e.message().trim_end().to_string();
+                ParamsError {
+                    key: crate::planner_params::key_in_message(&message, keys).or_else(|| {
+                        crate::planner_params::fault_key::<PlannerParams>(&table, keys)
+                    }),
+                    message,
+                }
+            })?;
+    params.validate().map_err(|e| {
+        let field = e
+            .invalid_parameter()
+            .map(|p| p.name.trim_start_matches("planner.").to_string());
+        ParamsError {
+            key: field,
+            message: e.to_string(),
+        }
+    })?;
+    Ok(params)
 }
 
 #[cfg(test)]

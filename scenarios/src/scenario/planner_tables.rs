@@ -1,0 +1,402 @@
+//! Each planner's own parameter tables in a scenario (`sim::planner_params`):
+//! `[sim.planners.NAME]` and a vehicle's `driver = { planner = "NAME", params = { … } }`.
+//!
+//! The potential-field planners' tables (`pf`, alias `[sim.planner]`; `pf-iso`; `pf-sp`;
+//! `planner::params_tables`) are views on the one `PlannerParams`: the loader merges them into
+//! the scenario's `planner_overrides`, applied on top of the `--params` set. Any other name's
+//! table stays in `sim.planners` for that planner's schema. A vehicle's `params` overlay its
+//! planner's table for that vehicle alone (`sim.vehicle_planner_params`).
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use planner::params_tables::{self, PF_TABLE, PF_TABLES};
+use sim::registry::BehaviourRegistry;
+use sim::{Driver, ParamsError};
+use toml::de::{DeTable, DeValue};
+
+use super::{Line, Scenario, ScenarioError, ScenarioSource};
+use crate::source_location::line_of;
+
+fn path(parts: &[&str]) -> Vec<String> {
+    parts.iter().map(|p| p.to_string()).collect()
+}
+
+fn invalid(
+    origin: &str,
+    text: Option<&str>,
+    at: &[Vec<String>],
+    field: String,
+    message: String,
+) -> ScenarioError {
+    let line = text.and_then(|t| at.iter().find_map(|p| line_of(t, p)));
+    ScenarioError::Invalid {
+        origin: origin.to_string(),
+        line: Line(line),
+        message: format!("{field}: {message}"),
+        field: Some(field),
+    }
+}
+
+/// The text with every vehicle's `driver.params` blanked out (spaces, so every other value
+/// keeps its line and column), and those tables by vehicle index. Only the inline form
+/// `driver = { planner = "NAME", params = { … } }` is read.
+pub(crate) fn strip_driver_params(
+    table: &toml::Table,
+    text: &str,
+    origin: &str,
+) -> Result<(String, BTreeMap<usize, toml::Table>), ScenarioError> {
+    let mut found = BTreeMap::new();
+    let Some(vehicles) = table.get("vehicles").and_then(|v| v.as_array()) else {
+        return Ok((text.to_string(), found));
+    };
+    for (i, vehicle) in vehicles.iter().enumerate() {
+        let Some(driver) = vehicle.get("driver").and_then(|d| d.as_table()) else {
+            continue;
+        };
+        let Some(params) = driver.get("params") else {
+            continue;
+        };
+        let at = path(&["vehicles", &i.to_string(), "driver", "params"]);
+        let field = format!("vehicles[#{i}].driver.params");
+        let Some(params) = params.as_table() else {
+            return Err(invalid(
+                origin,
+                Some(text),
+                &[at],
+                field,
+                "must be a table of the planner's parameters".into(),
+            ));
+        };
+        if !driver.get("planner").is_some_and(|p| p.is_str()) {
+            return Err(invalid(
+                origin,
+                Some(text),
+                &[at],
+                field,
+                "params go with a planner: driver = { planner = \"NAME\", params = { … } }".into(),
+            ));
+        }
+        found.insert(i, params.clone());
+    }
+    if found.is_empty() {
+        return Ok((text.to_string(), found));
+    }
+    let mut bytes = text.as_bytes().to_vec();
+    let root = DeTable::parse(text).map_err(|e| ScenarioError::Parse {
+        origin: origin.to_string(),
+        message: e.to_string(),
+    })?;
+    let root = DeValue::Table(root.into_inner());
+    for &i in found.keys() {
+        let field = format!("vehicles[#{i}].driver.params");
+        let at = path(&["vehicles", &i.to_string(), "driver", "params"]);
+        let driver = root
+            .get("vehicles")
+            .and_then(|v| v.get_ref().get(i))
+            .and_then(|v| v.get_ref().get("driver"));
+        // (key span, value span, end of the last value inside a `[vehicles.driver.params]`
+        // table written as a header).
+        let entry = driver.and_then(|d| match d.get_ref() {
+            DeValue::Table(t) => t
+                .iter()
+                .find(|(k, _)| k.get_ref().as_ref() == "params")
+                .map(|(k, v)| {
+                    let last_end = match v.get_ref() {
+                        DeValue::Table(inner) => inner
+                            .iter()
+                            .map(|(ik, iv)| ik.span().end.max(iv.span().end))
+                            .max(),
+                        _ => None,
+                    };
+                    (k.span(), v.span(), last_end)
+                }),
+            _ => None,
+        });
+        let Some((key, value, last_end)) = entry else {
+            return Err(invalid(
+                origin,
+                Some(text),
+                &[at],
+                field,
+                "cannot find it in the text".into(),
+            ));
+        };
+        let line_start = text[..key.start].rfind('\n').map_or(0, |i| i + 1);
+        let inline = text.as_bytes().get(value.start) == Some(&b'{');
+        let header = text[line_start..].trim_start().starts_with('[');
+        if !inline && !header {
+            return Err(invalid(
+                origin,
+                Some(text),
+                &[at],
+                field,
+                "write a vehicle's planner parameters as an inline table (driver = { planner = \
+                 \"NAME\", params = { … } }) or under a [vehicles.driver.params] header"
+                    .into(),
+            ));
+        }
+        let blank = |bytes: &mut Vec<u8>, from: usize, to: usize| {
+            for b in &mut bytes[from..to] {
+                if *b != b'\n' && *b != b'\r' {
+                    *b = b' ';
+                }
+            }
+        };
+        if !inline {
+            // The header line and the table's entries, to the end of its last entry's line.
+            let end = last_end.unwrap_or(key.end).max(key.end);
+            let end = text[end..].find('\n').map_or(text.len(), |i| end + i);
+            blank(&mut bytes, line_start, end);
+            continue;
+        }
+        blank(&mut bytes, key.start, value.end);
+        // The comma that separated it from its neighbour inside the inline table.
+        let before = text[..key.start].trim_end();
+        if before.ends_with(',') {
+            blank(&mut bytes, before.len() - 1, before.len());
+        } else {
+            let after = &text[value.end..];
+            let skipped = after.len() - after.trim_start().len();
+            if after.trim_start().starts_with(',') {
+                blank(&mut bytes, value.end + skipped, value.end + skipped + 1);
+            }
+        }
+    }
+    let stripped = String::from_utf8(bytes).map_err(|e| ScenarioError::Parse {
+        origin: origin.to_string(),
+        message: e.to_string(),
+    })?;
+    Ok((stripped, found))
+}
+
+impl Scenario {
+    /// Moves the PF planners' tables (`[sim.planner]`, `[sim.planners.pf]`, `…pf-iso]`,
+    /// `…pf-sp]`) into `planner_overrides`, refusing keys of another table, unknown keys and a
+    /// key written twice; a table named after a PF planner that reads another table is refused
+    /// naming that table.
+    pub(crate) fn take_pf_tables(
+        &mut self,
+        table: &toml::Table,
+        origin: &str,
+        text: &str,
+    ) -> Result<(), ScenarioError> {
+        // `[sim.planner]`, the alias of `pf`: as before, every PlannerParams field (an unknown
+        // key was refused by the typed reading).
+        let mut overrides: toml::Table = table
+            .get("sim")
+            .and_then(|sim| sim.get("planner"))
+            .and_then(|planner| planner.as_table())
+            .cloned()
+            .unwrap_or_default();
+        let mut written_in: BTreeMap<String, Vec<String>> = overrides
+            .keys()
+            .map(|k| (k.clone(), path(&["sim", "planner", k])))
+            .collect();
+        let pf_names: Vec<String> = planner::PlannerKind::ALL
+            .iter()
+            .map(|k| k.name().to_string())
+            .collect();
+        for (name, keys) in &self.sim.planners {
+            let at = |key: Option<&str>| {
+                let mut p = path(&["sim", "planners", name]);
+                p.extend(key.map(str::to_string));
+                p
+            };
+            if PF_TABLES.contains(&name.as_str()) {
+                for (key, value) in keys {
+                    let field = format!("planners.{name}.{key}");
+                    params_tables::check_key(name, key).map_err(|m| {
+                        invalid(origin, Some(text), &[at(Some(key))], field.clone(), m)
+                    })?;
+                    if let Some(first) = written_in.get(key) {
+                        let first_line = line_of(text, first)
+                            .map(|l| format!(" (line {l})"))
+                            .unwrap_or_default();
+                        return Err(invalid(
+                            origin,
+                            Some(text),
+                            &[at(Some(key))],
+                            field,
+                            format!(
+                                "written twice: already in [{}]{first_line}",
+                                first[..first.len() - 1].join(".")
+                            ),
+                        ));
+                    }
+                    written_in.insert(key.clone(), at(Some(key)));
+                    overrides.insert(key.clone(), value.clone());
+                }
+            } else if let Some(kind) = pf_names
+                .iter()
+                .position(|n| n == name)
+                .map(|i| planner::PlannerKind::ALL[i])
+            {
+                let own = params_tables::tables_of(kind);
+                return Err(invalid(
+                    origin,
+                    Some(text),
+                    &[at(None)],
+                    format!("planners.{name}"),
+                    format!(
+                        "{name} reads the tables {}: write its parameters there",
+                        own.iter()
+                            .map(|t| format!("[sim.planners.{t}]"))
+                            .collect::<Vec<_>>()
+                            .join(" and ")
+                    ),
+                ));
+            }
+        }
+        self.sim
+            .planners
+            .retain(|name, _| !PF_TABLES.contains(&name.as_str()));
+        self.planner_overrides = overrides;
+        Ok(())
+    }
+
+    /// The TOML path where PF field `key` is written: `[sim.planners.TABLE]` or the alias
+    /// `[sim.planner]` (for error lines).
+    pub(crate) fn pf_key_path(&self, key: &str) -> Vec<String> {
+        let table = params_tables::table_of_field(key).unwrap_or(PF_TABLE);
+        let new_form = path(&["sim", "planners", table, key]);
+        match &self.source {
+            Some(source) if line_of(&source.text, &new_form).is_some() => new_form,
+            _ => path(&["sim", "planner", key]),
+        }
+    }
+
+    /// A simulator field as the file wrote it: `planner.KEY` is `planners.TABLE.KEY` when the
+    /// key is written in a `[sim.planners.TABLE]`.
+    pub(crate) fn written_field(&self, field: String) -> String {
+        match field.strip_prefix("planner.") {
+            Some(key) => {
+                let path = self.pf_key_path(key);
+                if path[1] == "planners" {
+                    format!("planners.{}.{key}", path[2])
+                } else {
+                    field
+                }
+            }
+            None => field,
+        }
+    }
+
+    /// Checks each planner's tables against its schema in `registry`: `[sim.planners.NAME]`
+    /// and every vehicle's `driver.params` (overlaid on it). Refuses a table for a planner
+    /// `registry` does not hold, keys the schema does not know, values out of range and any
+    /// table for a planner registered without parameters; the error names the file, line and
+    /// field. Run it before any work with the registry the run uses (the loader runs it with
+    /// the built-in registry, skipping names it does not hold).
+    pub fn check_planners(&self, registry: &BehaviourRegistry) -> Result<(), ScenarioError> {
+        self.check_planner_tables(registry, false)
+    }
+
+    pub(crate) fn check_planner_tables(
+        &self,
+        registry: &BehaviourRegistry,
+        skip_unknown: bool,
+    ) -> Result<(), ScenarioError> {
+        let origin = self
+            .source
+            .as_ref()
+            .map(|s| s.origin.clone())
+            .unwrap_or_else(|| self.name.clone());
+        let text = self.source.as_ref().map(|s| s.text.as_str());
+        let table_at = |name: &str, key: Option<&str>| {
+            let mut p = path(&["sim", "planners", name]);
+            p.extend(key.map(str::to_string));
+            p
+        };
+        for name in self.sim.planners.keys() {
+            if !registry.contains(name) {
+                if skip_unknown {
+                    continue;
+                }
+                return Err(invalid(
+                    &origin,
+                    text,
+                    &[table_at(name, None)],
+                    format!("planners.{name}"),
+                    format!(
+                        "no planner {name:?} is registered (registered: {})",
+                        registry.names().join(", ")
+                    ),
+                ));
+            }
+            registry.parse_params(name, &self.sim, None).map_err(|e| {
+                let key = e.key.clone();
+                let mut at = vec![table_at(name, key.as_deref()), table_at(name, None)];
+                at.dedup();
+                let field = format!(
+                    "planners.{name}{}",
+                    key.map(|k| format!(".{k}")).unwrap_or_default()
+                );
+                invalid(&origin, text, &at, field, e.message)
+            })?;
+        }
+        for (i, vehicle) in self.vehicles.iter().enumerate() {
+            let Some(own) = self.sim.vehicle_planner_params.get(&vehicle.name) else {
+                continue;
+            };
+            let Driver::Planner(name) = &vehicle.driver else {
+                continue;
+            };
+            let own_at = |key: Option<&str>| {
+                let mut p = path(&["vehicles", &i.to_string(), "driver", "params"]);
+                p.extend(key.map(str::to_string));
+                p
+            };
+            let refused = |e: ParamsError| {
+                let in_own = e.key.as_ref().is_some_and(|k| own.contains_key(k));
+                let (at, field) = match (&e.key, in_own) {
+                    (Some(k), true) => (
+                        vec![own_at(Some(k)), own_at(None)],
+                        format!("vehicles[{}].driver.params.{k}", vehicle.name),
+                    ),
+                    (Some(k), false) if self.sim.planners.contains_key(name) => (
+                        vec![table_at(name, Some(k)), own_at(None)],
+                        format!("planners.{name}.{k}"),
+                    ),
+                    (Some(k), false) => (
+                        vec![self.pf_key_path(k), own_at(None)],
+                        format!("vehicles[{}].driver.params.{k}", vehicle.name),
+                    ),
+                    (None, _) => (
+                        vec![own_at(None)],
+                        format!("vehicles[{}].driver.params", vehicle.name),
+                    ),
+                };
+                invalid(
+                    &origin,
+                    text,
+                    &at,
+                    field,
+                    format!("planner {name}: {}", e.message),
+                )
+            };
+            if !registry.contains(name) {
+                // The run refuses an unknown planner itself (`SimError::UnknownPlanner`).
+                continue;
+            }
+            if let Some(kind) = registry.pf_kind(name) {
+                for key in own.keys() {
+                    params_tables::check_vehicle_key(kind, key)
+                        .map_err(|m| refused(ParamsError::at(key.clone(), m)))?;
+                }
+            }
+            registry
+                .parse_params(name, &self.sim, Some(own))
+                .map_err(refused)?;
+        }
+        Ok(())
+    }
+
+    /// Records where the scenario came from (for the lines of later checks).
+    pub(crate) fn set_source(&mut self, origin: &str, text: &str) {
+        self.source = Some(Arc::new(ScenarioSource {
+            origin: origin.to_string(),
+            text: text.to_string(),
+        }));
+    }
+}
