@@ -146,6 +146,40 @@ fn a_scenario_files_driver_names_the_users_planner() {
     let out = merge_sim(&["run", "--scenario", s(&scenario), "--no-rrd", "--quiet"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains(NAME), "{}", stderr(&out));
+    // The example registers its planner without a parameter type: a table for it is refused
+    // by the user's binary before any work, naming the file, the key's line and the planner,
+    // and nothing is written.
+    let text = std::fs::read_to_string(&scenario).unwrap();
+    // The text, an empty line, the table's header, its key.
+    let key_line = text.lines().count() + 3;
+    let with_table = dir.join("with_table.toml");
+    std::fs::write(
+        &with_table,
+        format!("{text}\n[sim.planners.{NAME}]\ntime_gap_s = 2.0\n"),
+    )
+    .unwrap();
+    let refused = dir.join("refused.json");
+    let out = Command::new(own_binary())
+        .args([
+            "run",
+            "--scenario",
+            s(&with_table),
+            "--no-rrd",
+            "--quiet",
+            "--json",
+            s(&refused),
+        ])
+        .output()
+        .expect("own_planner_cli runs");
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("with_table.toml")
+            && err.contains(&format!("line {key_line}: planners.{NAME}.time_gap_s"))
+            && err.contains("takes no parameters (it was registered without a parameter type"),
+        "{err}"
+    );
+    assert!(!refused.exists());
 }
 
 #[test]

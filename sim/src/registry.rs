@@ -275,7 +275,8 @@ impl BehaviourRegistry {
                     Some(key) => Err(ParamsError::at(
                         key.clone(),
                         format!(
-                            "planner {name} takes no parameters (it was registered without a                              parameter type: register it with register_with_params)"
+                            "planner {name} takes no parameters (it was registered without a \
+                             parameter type: register it with register_with_params)"
                         ),
                     )),
                 }

@@ -58,7 +58,7 @@ pub(crate) fn progress_bar(quiet: bool, len: u64, message: String) -> indicatif:
 }
 
 pub(crate) fn cmd_compare(args: &CompareArgs, session: &Session) -> Result<(), Failure> {
-    let scenario = load_source(&args.source)?;
+    let scenario = load_source(&args.source, &session.registry)?;
     check_outputs(
         &[
             (args.json.as_deref(), "--json"),
@@ -205,7 +205,7 @@ fn grid_vehicle(scenario: &Scenario, asked: Option<&str>) -> Result<String, Fail
 pub(crate) fn cmd_grid(args: &GridArgs, session: &Session) -> Result<(), Failure> {
     let interrupt = &session.interrupt;
     use crate::grid::{GridAxes, GridMetric, GridPlan, MAX_GRID_RUNS, job_count, run_grid};
-    let scenario = load_source(&args.source)?;
+    let scenario = load_source(&args.source, &session.registry)?;
     let vehicle = grid_vehicle(&scenario, args.vehicle.as_deref())?;
     if args.runs > MAX_GRID_RUNS {
         return Err(input(anyhow!(

@@ -27,7 +27,7 @@ const RECORDING_WARNING_BYTES: f64 = 500e6;
 
 /// `merge_sim run` (and `merge_sim` with no subcommand).
 pub(crate) fn cmd_run(args: &RunArgs, session: &Session) -> Result<(), Failure> {
-    let job = load(args)?;
+    let job = load(args, &session.registry)?;
     let follow = job.check()?;
     let finished = job.simulate(&follow, session)?;
     job.write(&follow, &finished)
@@ -61,8 +61,8 @@ struct RunJob<'a> {
 }
 
 /// Step 1: loads the scenario and resolves every argument.
-fn load(args: &RunArgs) -> Result<RunJob<'_>, Failure> {
-    let scenario = load_source(&args.source)?;
+fn load<'a>(args: &'a RunArgs, registry: &sim::BehaviourRegistry) -> Result<RunJob<'a>, Failure> {
+    let scenario = load_source(&args.source, registry)?;
     if !cfg!(feature = "rerun") && (args.rrd.is_some() || args.view) {
         return Err(input(anyhow!(
             "{}",

@@ -11,8 +11,12 @@ use crate::cli::{Failure, Session, args, input, interrupted, run_failure};
 use crate::experiment::{Finished, InstanceOptions, RunError, planner_label, run_instance};
 
 /// Loads the scenario of `--scenario`, with `--params`, `--recorded-traffic` and `--duration`
-/// applied.
-pub(crate) fn load_source(source: &args::ScenarioArgs) -> Result<Scenario, Failure> {
+/// applied, and checks its planners and their parameter tables against `registry` (a name
+/// or a table the registry refuses is bad input, with the file, line and field).
+pub(crate) fn load_source(
+    source: &args::ScenarioArgs,
+    registry: &sim::BehaviourRegistry,
+) -> Result<Scenario, Failure> {
     let mut scenario = load_scenario(&source.scenario, source.params)?;
     if let Some(mode) = source.recorded_traffic {
         scenario = scenario.with_recorded_traffic(mode).map_err(input)?;
@@ -20,6 +24,7 @@ pub(crate) fn load_source(source: &args::ScenarioArgs) -> Result<Scenario, Failu
     if let Some(duration_s) = source.duration {
         scenario = scenario.with_duration(duration_s).map_err(input)?;
     }
+    scenario.check_planners(registry).map_err(input)?;
     let traffic = &scenario.sim.recorded_traffic;
     if !traffic.is_empty() {
         let recording_end_s = traffic

@@ -26,7 +26,7 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, session: &Session) -> Result<(), Failu
         PairedSweepPlan, Shard, SweepIdentity, SweepOptions, resume::read_jsonl, run_paired_sweep,
         validate_paired,
     };
-    let scenario = load_source(&args.source)?;
+    let scenario = load_source(&args.source, &session.registry)?;
     // An existing JSONL passes (a regular file): --resume reads it back, else it is refused
     // below.
     check_outputs(
