@@ -1,4 +1,5 @@
-//! The potential-field planners' parameter tables: views on the one [`PlannerParams`].
+//! The potential-field planners' parameter tables: views on the one
+//! [`PlannerParams`](crate::params::PlannerParams).
 //!
 //! Every PF planner keeps one `PlannerParams` inside (results do not depend on how a value
 //! was written). A scenario writes its fields in one of three tables, each field in exactly
