@@ -16,6 +16,7 @@ pub mod metrics;
 pub mod observer;
 pub mod outcome;
 pub mod paper_metrics;
+pub mod planner_stats;
 pub mod planner_params;
 pub mod profile;
 pub mod recorded_motion;

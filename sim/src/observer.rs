@@ -49,6 +49,11 @@ pub struct PlanView<'a, 'o> {
     pub field: &'a dyn Fn(&GridSpec) -> Option<Vec<f64>>,
     /// Whether the field-logging period has come.
     pub field_due: bool,
+    /// Wall time of its `plan` call (µs); not reproducible.
+    pub plan_time_us: f64,
+    /// How its optimiser ended this cycle, if it reports one
+    /// (`Behaviour::optimiser_report`).
+    pub optimiser: Option<mergesim_types::OptimiserReport>,
 }
 
 /// Something that watches a run (module doc). Every method defaults to doing nothing.

@@ -21,7 +21,8 @@ use crate::error::SimError;
 use crate::event::SimEvent;
 use crate::metrics::{MetricsSample, VehicleMetrics};
 use crate::observer::{TickObserver, VehicleView};
-use crate::outcome::{PlannerStats, RunOutcome};
+use crate::outcome::RunOutcome;
+use crate::planner_stats::PlannerStatsObserver;
 use crate::profile::{Phase, Profiler};
 use crate::recording::Recorder;
 use crate::recording_observer::RecordingObserver;
@@ -69,11 +70,7 @@ pub struct World {
     recording: RecordingObserver,
     observers: Vec<Box<dyn TickObserver>>,
     events: Vec<SimEvent>,
-    plan_times_us: Vec<f64>,
-    fallbacks: u64,
-    degraded_plans: u64,
-    optimiser_solves: u64,
-    optimiser_iteration_cap_cycles: u64,
+    planner_stats: PlannerStatsObserver,
     step_index: u64,
     steps_per_plan: u64,
     steps_per_log: u64,
@@ -178,11 +175,7 @@ impl World {
             recording,
             observers: Vec::new(),
             events: Vec::new(),
-            plan_times_us: Vec::new(),
-            fallbacks: 0,
-            degraded_plans: 0,
-            optimiser_solves: 0,
-            optimiser_iteration_cap_cycles: 0,
+            planner_stats: PlannerStatsObserver::default(),
             step_index: 0,
             profiler: Profiler::new(options.profile),
             planning_pool: None,
@@ -368,6 +361,7 @@ impl World {
         &mut self,
         mut f: impl FnMut(&mut dyn TickObserver) -> Result<(), SimError>,
     ) -> Result<(), SimError> {
+        f(&mut self.planner_stats)?;
         f(&mut self.run_log)?;
         f(&mut self.recording)?;
         for observer in &mut self.observers {

@@ -39,17 +39,9 @@ pub fn wilson_interval(successes: u64, n: u64, z: f64) -> Option<[f64; 2]> {
     Some([lo, hi])
 }
 
-/// Nearest-rank percentile of ascending `sorted` values: the smallest value such that at least
-/// `percent` % of the values are less than or equal to it, i.e. `sorted[⌈percent/100 · n⌉ − 1]`
-/// (rank 1 for `percent` = 0). Always one of the samples (no interpolation), so it is exact and
-/// does not depend on how the samples were split. `None` for no samples.
-pub fn nearest_rank_percentile(sorted: &[f64], percent: f64) -> Option<f64> {
-    if sorted.is_empty() || !(0.0..=100.0).contains(&percent) {
-        return None;
-    }
-    let rank = (percent / 100.0 * sorted.len() as f64).ceil() as usize;
-    sorted.get(rank.max(1) - 1).copied()
-}
+/// The project's one percentile (`mergesim_types::percentile`), here beside the other
+/// statistics of a sweep.
+pub use mergesim_types::percentile::nearest_rank_percentile;
 
 /// Arithmetic mean, summed in the given order. `None` for no values.
 pub fn mean(values: &[f64]) -> Option<f64> {

@@ -14,6 +14,7 @@ pub mod files;
 pub mod grid;
 pub mod lanes;
 pub mod path;
+pub mod percentile;
 pub mod road;
 pub mod vehicle;
 

@@ -101,17 +101,7 @@ impl World {
                 min_ttc_s: safety.min_ttc_s,
             })?;
         }
-        let mut times = self.plan_times_us.clone();
-        times.sort_by(f64::total_cmp);
-        let planner_stats = PlannerStats {
-            plans: times.len() as u64,
-            fallbacks: self.fallbacks,
-            degraded_plans: self.degraded_plans,
-            optimiser_solves: self.optimiser_solves,
-            optimiser_iteration_cap_cycles: self.optimiser_iteration_cap_cycles,
-            p50_plan_us: percentile(&times, 0.50),
-            p99_plan_us: percentile(&times, 0.99),
-        };
+        let planner_stats = self.planner_stats.stats();
         let vehicles = self.run_log.summaries();
         let v2v = self.bus.stats();
         let duration_s = self.time_s();
@@ -130,14 +120,6 @@ impl World {
             goals,
         })
     }
-}
-
-fn percentile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return 0.0;
-    }
-    let rank = (q * (sorted.len() - 1) as f64).round() as usize;
-    sorted[rank.min(sorted.len() - 1)]
 }
 
 /// The speed the path asks for at time `t_s` (linear in time between its points).

@@ -134,16 +134,7 @@ impl World {
             let name = agent.spec.name.clone();
             let connected = agent.spec.connected;
             if is_planner {
-                self.plan_times_us.push(elapsed_us);
-                if let Some(report) = agent.behaviour.optimiser_report() {
-                    self.optimiser_solves += u64::from(report.solves);
-                    if report.stopped_at_iteration_cap {
-                        self.optimiser_iteration_cap_cycles += 1;
-                    }
-                }
-                if decision.degraded_mode.is_some() {
-                    self.degraded_plans += 1;
-                }
+                let optimiser = agent.behaviour.optimiser_report();
                 if decision.degraded_mode != self.agents[index].degraded_mode {
                     let event = match (&decision.degraded_mode, &self.agents[index].degraded_mode) {
                         (Some(mode), _) => Some(SimEvent::DegradedModeEntered {
@@ -165,7 +156,6 @@ impl World {
                     }
                 }
                 if let Some(reason) = &decision.fallback {
-                    self.fallbacks += 1;
                     self.event(SimEvent::PlannerFallback {
                         t_s,
                         vehicle: name.clone(),
@@ -180,8 +170,11 @@ impl World {
                     decision: &decision,
                     field: &field,
                     field_due,
+                    plan_time_us: elapsed_us,
+                    optimiser,
                 };
                 let observed = self.profiler.start();
+                self.planner_stats.on_plan(t_s, &view)?;
                 self.run_log.on_plan(t_s, &view)?;
                 for observer in &mut self.observers {
                     observer.on_plan(t_s, &view)?;
