@@ -63,7 +63,10 @@ mod tests {
     #[test]
     fn no_cycle_gives_zero_figures_and_the_percentiles_are_samples() {
         let empty = PlannerStatsObserver::default().stats();
-        assert_eq!((empty.plans, empty.p50_plan_us, empty.p99_plan_us), (0, 0.0, 0.0));
+        assert_eq!(
+            (empty.plans, empty.p50_plan_us, empty.p99_plan_us),
+            (0, 0.0, 0.0)
+        );
         let observer = PlannerStatsObserver {
             plan_times_us: (1..=200).rev().map(f64::from).collect(),
             ..PlannerStatsObserver::default()
