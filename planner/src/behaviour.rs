@@ -1,6 +1,8 @@
 //! The potential-field planners as a vehicle [`Behaviour`] (the simulator's extension point).
 
-use mergesim_types::{Behaviour, BehaviourError, Decision, GridSpec, Observation, OptimiserReport};
+use mergesim_types::{
+    Behaviour, BehaviourError, Decision, DegradedMode, GridSpec, Observation, OptimiserReport,
+};
 
 use crate::planners::{PfPlanner, PlanRequest};
 
@@ -30,7 +32,7 @@ impl Behaviour for PfPlanner {
             degraded_mode: self
                 .last_stats()
                 .v2v_degraded
-                .then(|| "v2v-lost".to_string()),
+                .then_some(DegradedMode::V2vLost),
         })
     }
 

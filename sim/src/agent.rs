@@ -31,7 +31,7 @@ pub struct Agent {
     /// The lane it is in (`crate::lane_membership`), last checked at a logged instant.
     pub lane: LaneId,
     /// The degraded mode of its last decision (events on changes).
-    pub degraded_mode: Option<String>,
+    pub degraded_mode: Option<mergesim_types::DegradedMode>,
 }
 
 /// The behaviour of `spec`: its planner from the registry (or `planner_override`, which

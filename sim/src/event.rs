@@ -6,6 +6,7 @@
 
 use std::fmt;
 
+use mergesim_types::DegradedMode;
 use mergesim_types::lanes::LaneId;
 use serde::{Deserialize, Serialize};
 
@@ -98,7 +99,7 @@ pub enum SimEvent {
         /// The vehicle.
         vehicle: String,
         /// The mode (e.g. `v2v-lost`).
-        mode: String,
+        mode: DegradedMode,
     },
     /// A vehicle's planner left its degraded mode.
     DegradedModeLeft {
@@ -107,7 +108,7 @@ pub enum SimEvent {
         /// The vehicle.
         vehicle: String,
         /// The mode it left.
-        mode: String,
+        mode: DegradedMode,
     },
     /// A vehicle's planner fell back (`Decision::fallback`).
     PlannerFallback {
@@ -275,6 +276,32 @@ mod tests {
         let json = serde_json::to_string(&event).unwrap();
         assert!(json.starts_with(r#"{"kind":"collision""#), "{json}");
         assert_eq!(serde_json::from_str::<SimEvent>(&json).unwrap(), event);
+    }
+
+    #[test]
+    fn a_degraded_mode_is_named_as_the_log_always_named_it() {
+        let entered = SimEvent::DegradedModeEntered {
+            t_s: 1.0,
+            vehicle: "ego".into(),
+            mode: DegradedMode::V2vLost,
+        };
+        assert_eq!(
+            entered.to_string(),
+            "t = 1.00 s: ego plans in degraded mode v2v-lost"
+        );
+        let left = SimEvent::DegradedModeLeft {
+            t_s: 2.5,
+            vehicle: "car".into(),
+            mode: DegradedMode::Other("dead-reckoning".into()),
+        };
+        assert_eq!(
+            left.to_string(),
+            "t = 2.50 s: car left degraded mode dead-reckoning"
+        );
+        assert_eq!(
+            serde_json::to_string(&DegradedMode::V2vLost).unwrap(),
+            r#""v2v-lost""#
+        );
     }
 
     #[test]

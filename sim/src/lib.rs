@@ -41,9 +41,9 @@ pub use event::SimEvent;
 /// the simulator.
 pub use mergesim_types::lanes;
 pub use mergesim_types::{
-    Behaviour, BehaviourError, Decision, GridSpec, Lane, MergeRoad, Neighbour, Observation,
-    OptimiserReport, PathPoint, SharedLocalPath, TimedWaypoint, VehicleId, VehicleShape,
-    VehicleState,
+    Behaviour, BehaviourError, Decision, DegradedMode, GridSpec, Lane, MergeRoad, Neighbour,
+    Observation, OptimiserReport, PathPoint, SharedLocalPath, TimedWaypoint, VehicleId,
+    VehicleShape, VehicleState,
 };
 pub use observer::{PlanView, TickObserver, VehicleView};
 pub use outcome::{PlannerStats, RecordedPose, RunOutcome, TimeSeriesRow};

@@ -69,10 +69,31 @@ pub struct Decision {
     pub broadcast: Option<SharedLocalPath>,
     /// Why this decision is a fallback (logged and counted), if it is one.
     pub fallback: Option<String>,
-    /// The degraded mode this decision was made in, if any (e.g. `v2v-lost`: no shared path
-    /// heard from anybody around); the simulator counts such decisions and logs when a
-    /// vehicle enters and leaves a mode.
-    pub degraded_mode: Option<String>,
+    /// The degraded mode this decision was made in, if any (e.g. [`DegradedMode::V2vLost`]:
+    /// no shared path heard from anybody around); the simulator counts such decisions and logs
+    /// when a vehicle enters and leaves a mode.
+    pub degraded_mode: Option<DegradedMode>,
+}
+
+/// A degraded mode a decision was made in (`Decision::degraded_mode`). `Display` gives its
+/// name as the event log writes it (`v2v-lost`).
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DegradedMode {
+    /// No shared local path heard from any vehicle around (V2V lost): PF-ISO plans with its
+    /// `v2v_loss_fallback` instead of the interaction term.
+    V2vLost,
+    /// A user's planner's own mode, by its name.
+    Other(String),
+}
+
+impl std::fmt::Display for DegradedMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::V2vLost => f.write_str("v2v-lost"),
+            Self::Other(name) => f.write_str(name),
+        }
+    }
 }
 
 impl Decision {

@@ -18,7 +18,9 @@ pub mod percentile;
 pub mod road;
 pub mod vehicle;
 
-pub use behaviour::{Behaviour, BehaviourError, Decision, Observation, OptimiserReport};
+pub use behaviour::{
+    Behaviour, BehaviourError, Decision, DegradedMode, Observation, OptimiserReport,
+};
 pub use bounds::Bound;
 pub use error::InvalidParameter;
 pub use grid::{GridSpec, MAX_GRID_CELLS};
