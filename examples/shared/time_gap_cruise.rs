@@ -7,7 +7,6 @@ use std::sync::Arc;
 
 use mergesim::sim::{
     Behaviour, BehaviourError, BehaviourFactory, Decision, FactoryInput, Observation, PathPoint,
-    SharedLocalPath,
 };
 
 /// Constant-time-gap cruise control along the through lane.
@@ -61,19 +60,7 @@ impl Behaviour for TimeGapCruise {
                 }
             })
             .collect();
-        let broadcast = SharedLocalPath::from_path(
-            obs.ego_id,
-            obs.time_s,
-            obs.ego_shape,
-            obs.ego.speed_mps,
-            &path,
-        );
-        Ok(Decision {
-            path,
-            broadcast: Some(broadcast),
-            fallback: None,
-            degraded_mode: None,
-        })
+        Ok(Decision::follow_and_share(path, obs))
     }
 }
 

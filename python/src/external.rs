@@ -4,7 +4,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use sim::{Behaviour, BehaviourError, Decision, Observation, PathPoint, SharedLocalPath};
+use sim::{Behaviour, BehaviourError, Decision, Observation, PathPoint};
 
 /// Name the behaviour is registered under (for the agent's vehicle only).
 pub const EXTERNAL_PLANNER: &str = "external";
@@ -72,17 +72,7 @@ impl Behaviour for External {
             .unwrap_or_else(std::sync::PoisonError::into_inner);
         let path = commanded_path(command, obs.ego.x_m, obs.ego.y_m, obs.time_s);
         // Shared like a planner's path, so connected PF-ISO vehicles see where it goes.
-        let broadcast = SharedLocalPath::from_path(
-            obs.ego_id,
-            obs.time_s,
-            obs.ego_shape,
-            obs.ego.speed_mps,
-            &path,
-        );
-        Ok(Decision {
-            broadcast: Some(broadcast),
-            ..Decision::follow(path)
-        })
+        Ok(Decision::follow_and_share(path, obs))
     }
 
     fn is_planner(&self) -> bool {

@@ -20,8 +20,7 @@ use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, PoisonError};
 
 use mergesim_types::{
-    Behaviour, BehaviourError, Decision, Observation, PathPoint, SharedLocalPath, VehicleShape,
-    VehicleState,
+    Behaviour, BehaviourError, Decision, Observation, PathPoint, VehicleShape, VehicleState,
 };
 use pyo3::intern;
 use pyo3::prelude::*;
@@ -372,19 +371,13 @@ fn decision(value: &Bound<'_, PyAny>, obs: &Observation<'_>) -> Result<Decision,
     if path.is_empty() {
         return Err("the path is empty".into());
     }
-    let broadcast = broadcast.then(|| {
-        SharedLocalPath::from_path(
-            obs.ego_id,
-            obs.time_s,
-            obs.ego_shape,
-            obs.ego.speed_mps,
-            &path,
-        )
-    });
+    let decision = if broadcast {
+        Decision::follow_and_share(path, obs)
+    } else {
+        Decision::follow(path)
+    };
     Ok(Decision {
-        path,
-        broadcast,
         fallback,
-        degraded_mode: None,
+        ..decision
     })
 }

@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 use sim::recording::Recorder;
 use sim::{
     Behaviour, BehaviourError, BehaviourRegistry, Decision, Driver, FactoryInput, Lane,
-    Observation, PathPoint, RunOptions, SharedLocalPath, SimConfig, VehicleId, VehicleSpec, World,
+    Observation, PathPoint, RunOptions, SimConfig, VehicleId, VehicleSpec, World,
 };
 
 /// What one vehicle was given over the run: neighbour ids and shared-path sender ids.
@@ -45,15 +45,7 @@ impl Behaviour for Witness {
                 t_s: obs.time_s + 3.0 * i as f64 / v,
             })
             .collect();
-        let mut decision = Decision::follow(path.clone());
-        decision.broadcast = Some(SharedLocalPath::from_path(
-            obs.ego_id,
-            obs.time_s,
-            obs.ego_shape,
-            obs.ego.speed_mps,
-            &path,
-        ));
-        Ok(decision)
+        Ok(Decision::follow_and_share(path, obs))
     }
 }
 

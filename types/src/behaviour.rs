@@ -106,6 +106,23 @@ impl Decision {
             degraded_mode: None,
         }
     }
+
+    /// Follow `path` and broadcast it as the vehicle's shared local path, stamped with the
+    /// observation's time, the vehicle's id, shape and current speed (what a connected
+    /// planner usually shares, so PF-ISO vehicles around see where it goes).
+    pub fn follow_and_share(path: Vec<PathPoint>, obs: &Observation<'_>) -> Self {
+        let broadcast = SharedLocalPath::from_path(
+            obs.ego_id,
+            obs.time_s,
+            obs.ego_shape,
+            obs.ego.speed_mps,
+            &path,
+        );
+        Self {
+            broadcast: Some(broadcast),
+            ..Self::follow(path)
+        }
+    }
 }
 
 /// How the last cycle's optimiser ended (optional: [`Behaviour::optimiser_report`]); the
