@@ -287,6 +287,36 @@ primary = {{ figure = "obstacle.max_abs_yaw_rate_radps", threshold = "0.01 rad/s
     let out = merge_sim(&["study", s(&plan), "--out", s(&dir.join("stock")), "--quiet"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains(NAME), "{}", stderr(&out));
+    // A scenario giving the planner a table it cannot take (registered without a parameter
+    // type) is refused when the plan loads, naming the scenario's file and the key's line,
+    // before any run and with nothing written.
+    let toml = String::from_utf8(merge_sim(&["scenario", "show", "urgent_merge"]).stdout).unwrap();
+    let key_line = toml.lines().count() + 3;
+    std::fs::write(
+        dir.join("tabled.toml"),
+        format!("{toml}\n[sim.planners.{NAME}]\ntime_gap_s = 2.0\n"),
+    )
+    .unwrap();
+    let tabled_plan = dir.join("tabled_plan.toml");
+    let text = std::fs::read_to_string(&plan).unwrap();
+    std::fs::write(
+        &tabled_plan,
+        text.replace("scenario = \"urgent_merge\"", "scenario = \"tabled.toml\""),
+    )
+    .unwrap();
+    let out_dir = dir.join("tabled.report");
+    let out = Command::new(own_binary())
+        .args(["study", s(&tabled_plan), "--out", s(&out_dir), "--quiet"])
+        .output()
+        .expect("own_planner_cli runs");
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("tabled.toml")
+            && err.contains(&format!("line {key_line}: planners.{NAME}.time_gap_s")),
+        "{err}"
+    );
+    assert!(!out_dir.exists());
 }
 
 #[test]

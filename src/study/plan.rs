@@ -257,6 +257,11 @@ impl StudyPlan {
             Scenario::load(&scenario_path.to_string_lossy())
         }
         .map_err(|e| invalid(&["scenario"], "scenario", e.to_string()))?;
+        // Its planners' parameter tables, by the registry the study runs with (the error names
+        // the scenario's file, line and field).
+        scenario
+            .check_planners(registry)
+            .map_err(|e| invalid(&["scenario"], "scenario", e.to_string()))?;
         // Planners.
         let unknown = |name: &str| crate::experiment::unknown_planner(registry, name);
         let mut planners: Vec<String> = Vec::new();
