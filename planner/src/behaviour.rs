@@ -26,7 +26,7 @@ impl Behaviour for PfPlanner {
     fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError> {
         let plan = PfPlanner::plan(self, &request(obs))?;
         Ok(Decision {
-            fallback: plan.fallback.as_ref().map(|reason| format!("{reason:?}")),
+            fallback: plan.fallback.clone(),
             path: plan.path,
             broadcast: Some(plan.shared),
             degraded_mode: self

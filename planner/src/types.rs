@@ -4,17 +4,9 @@
 use serde::{Deserialize, Serialize};
 
 pub use mergesim_types::{
-    Neighbour, PathPoint, SharedLocalPath, TimedWaypoint, VehicleId, VehicleShape, VehicleState,
+    FallbackReason, Neighbour, PathPoint, SharedLocalPath, TimedWaypoint, VehicleId,
+    VehicleShape, VehicleState,
 };
-
-/// Why a plan is a fallback rather than the optimiser's answer.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum FallbackReason {
-    /// The convex solver did not converge.
-    SolverFailed(String),
-    /// A non-finite number appeared.
-    NonFinite(String),
-}
 
 /// The output of one planning cycle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

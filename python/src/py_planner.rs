@@ -20,7 +20,8 @@ use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, PoisonError};
 
 use mergesim_types::{
-    Behaviour, BehaviourError, Decision, Observation, PathPoint, VehicleShape, VehicleState,
+    Behaviour, BehaviourError, Decision, FallbackReason, Observation, PathPoint, VehicleShape,
+    VehicleState,
 };
 use pyo3::intern;
 use pyo3::prelude::*;
@@ -329,10 +330,9 @@ fn decision(value: &Bound<'_, PyAny>, obs: &Observation<'_>) -> Result<Decision,
         {
             None => None,
             Some(f) if f.is_none() => None,
-            Some(f) => Some(
-                f.extract::<String>()
-                    .map_err(|_| "decision[\"fallback\"]: must be a string or None".to_string())?,
-            ),
+            Some(f) => Some(FallbackReason::Other(f.extract::<String>().map_err(|_| {
+                "decision[\"fallback\"]: must be a string or None".to_string()
+            })?)),
         };
         (path, broadcast, fallback)
     } else {

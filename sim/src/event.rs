@@ -6,7 +6,7 @@
 
 use std::fmt;
 
-use mergesim_types::DegradedMode;
+use mergesim_types::{DegradedMode, FallbackReason};
 use mergesim_types::lanes::LaneId;
 use serde::{Deserialize, Serialize};
 
@@ -117,7 +117,7 @@ pub enum SimEvent {
         /// The vehicle.
         vehicle: String,
         /// Why.
-        reason: String,
+        reason: FallbackReason,
     },
     /// At the end of a run: the closest approach came within the near-miss thresholds.
     NearMiss {

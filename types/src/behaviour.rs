@@ -68,11 +68,34 @@ pub struct Decision {
     /// The message to broadcast (sent only if the vehicle is connected).
     pub broadcast: Option<SharedLocalPath>,
     /// Why this decision is a fallback (logged and counted), if it is one.
-    pub fallback: Option<String>,
+    pub fallback: Option<FallbackReason>,
     /// The degraded mode this decision was made in, if any (e.g. [`DegradedMode::V2vLost`]:
     /// no shared path heard from anybody around); the simulator counts such decisions and logs
     /// when a vehicle enters and leaves a mode.
     pub degraded_mode: Option<DegradedMode>,
+}
+
+/// Why a decision is a fallback rather than its planner's regular answer
+/// (`Decision::fallback`). `Display` gives the reason as the event log writes it.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum FallbackReason {
+    /// The planner's solver did not converge (its message).
+    SolverFailed(String),
+    /// A non-finite number appeared (where).
+    NonFinite(String),
+    /// A user's planner's own reason, in its words.
+    Other(String),
+}
+
+impl std::fmt::Display for FallbackReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // The built-in reasons keep the form the event log has always had.
+        match self {
+            Self::SolverFailed(message) => write!(f, "SolverFailed({message:?})"),
+            Self::NonFinite(what) => write!(f, "NonFinite({what:?})"),
+            Self::Other(reason) => f.write_str(reason),
+        }
+    }
 }
 
 /// A degraded mode a decision was made in (`Decision::degraded_mode`). `Display` gives its
@@ -156,5 +179,21 @@ pub trait Behaviour: Send {
     /// Its potential field on `spec`'s grid, row after row, for drawing; `None` if it has none.
     fn potential_field(&self, _obs: &Observation<'_>, _spec: &GridSpec) -> Option<Vec<f64>> {
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FallbackReason;
+
+    #[test]
+    fn fallback_reasons_read_as_the_event_log_has_always_written_them() {
+        // Before the reason was typed, the log wrote the planner's reason with `{:?}`.
+        let solver = FallbackReason::SolverFailed("max \"iterations\"".into());
+        assert_eq!(solver.to_string(), format!("{solver:?}"));
+        let non_finite = FallbackReason::NonFinite("speed".into());
+        assert_eq!(non_finite.to_string(), "NonFinite(\"speed\")");
+        // A user's reason is written as given.
+        assert_eq!(FallbackReason::Other("no gap".into()).to_string(), "no gap");
     }
 }

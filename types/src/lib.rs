@@ -19,7 +19,8 @@ pub mod road;
 pub mod vehicle;
 
 pub use behaviour::{
-    Behaviour, BehaviourError, Decision, DegradedMode, Observation, OptimiserReport,
+    Behaviour, BehaviourError, Decision, DegradedMode, FallbackReason, Observation,
+    OptimiserReport,
 };
 pub use bounds::Bound;
 pub use error::InvalidParameter;
