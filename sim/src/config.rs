@@ -30,7 +30,8 @@ pub struct SimConfig {
     pub lane_road: Option<LaneRoadConfig>,
     /// Tire–road friction coefficient μ.
     pub mu: f64,
-    /// Physics step (s).
+    /// Physics step (s): read once to build the physics world, which owns the step during a run
+    /// (`vehicles::PhysicsWorld::dt_s`; the world's time and periods are counted in its steps).
     pub dt_s: f64,
     /// Simulated time (s).
     pub duration_s: f64,

@@ -119,7 +119,9 @@ impl World {
         config.validate()?;
         crate::config::validate_vehicles(&config, specs)?;
         let lanes = std::sync::Arc::new(config.lanes()?);
+        // The physics world owns the step from here on (`config.dt_s` is its input only).
         let mut physics = PhysicsWorld::new(config.dt_s)?;
+        let dt_s = physics.dt_s();
         // Built from the lanes, around a local origin near the road (module doc of
         // `vehicles::PhysicsWorld`); the vehicles report the road's own coordinates.
         physics.add_lane_road(&lanes);
@@ -159,10 +161,10 @@ impl World {
             .collect();
         let recording = RecordingObserver::new(recorder, &lanes)?;
         Ok(Self {
-            steps_per_plan: steps_for(config.planner_period_s, config.dt_s),
-            steps_per_log: steps_for(config.log_period_s, config.dt_s),
-            steps_per_field: steps_for(config.field_log_period_s, config.dt_s),
-            steps_per_safety: steps_for(config.safety_period_s, config.dt_s),
+            steps_per_plan: steps_for(config.planner_period_s, dt_s),
+            steps_per_log: steps_for(config.log_period_s, dt_s),
+            steps_per_field: steps_for(config.field_log_period_s, dt_s),
+            steps_per_safety: steps_for(config.safety_period_s, dt_s),
             config,
             lanes,
             physics,
@@ -193,7 +195,7 @@ impl World {
 
     /// Simulated time now (s).
     pub fn time_s(&self) -> f64 {
-        self.step_index as f64 * self.config.dt_s
+        self.step_index as f64 * self.physics.dt_s()
     }
 
     /// Every vehicle's kinematic state now, in id order (for a caller stepping the world by
@@ -221,7 +223,7 @@ impl World {
 
     /// Number of physics steps of the whole run.
     pub fn total_steps(&self) -> u64 {
-        (self.config.duration_s / self.config.dt_s).round() as u64
+        (self.config.duration_s / self.physics.dt_s()).round() as u64
     }
 
     /// Runs to the end; `progress(fraction)` is called about a hundred times.
@@ -272,7 +274,7 @@ impl World {
             self.plan_all(t_s)?;
         }
         // 3.–4. Tracking, forces.
-        let dt_s = self.config.dt_s;
+        let dt_s = self.physics.dt_s();
         let (mut tracking, mut forces) = (Duration::ZERO, Duration::ZERO);
         for agent in &mut self.agents {
             let started = self.profiler.start();
@@ -484,7 +486,7 @@ impl World {
         let handovers = self.recorded.advance(
             t_s,
             // The world's clock after the step (`Self::time_s`), not t + dt rounded apart.
-            (self.step_index + 1) as f64 * self.config.dt_s,
+            (self.step_index + 1) as f64 * self.physics.dt_s(),
             &self.lanes,
             &simulated,
             &mut self.physics,
