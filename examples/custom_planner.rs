@@ -32,7 +32,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut scenario = Scenario::load("urgent_merge")?;
     for vehicle in &mut scenario.vehicles {
         if vehicle.name == "obstacle" {
-            vehicle.driver = Driver::Planner("time-gap-cruise".into());
+            vehicle.driver = Driver::planner("time-gap-cruise");
         }
     }
 

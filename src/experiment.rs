@@ -68,7 +68,7 @@ pub fn planner_label(scenario: &Scenario, planner: Option<&str>) -> String {
         .vehicles
         .iter()
         .filter_map(|v| match &v.driver {
-            sim::Driver::Planner(name) => Some(name.as_str()),
+            sim::Driver::Planner { name, .. } => Some(name.as_str()),
             _ => None,
         })
         .collect();

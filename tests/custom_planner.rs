@@ -63,7 +63,7 @@ fn registry() -> BehaviourRegistry {
 #[test]
 fn a_registered_planner_drives_its_vehicle_among_pf_iso_traffic() {
     let mut scenario = Scenario::load("urgent_merge").unwrap();
-    scenario.vehicles[1].driver = Driver::Planner("fixed-12".into());
+    scenario.vehicles[1].driver = Driver::planner("fixed-12");
     let finished = run_instance(
         &scenario,
         &InstanceOptions::default(),
@@ -116,7 +116,7 @@ fn a_registered_planner_drives_its_vehicle_among_pf_iso_traffic() {
 #[test]
 fn an_unregistered_planner_is_refused_before_the_run_with_the_valid_names() {
     let mut scenario = Scenario::load("urgent_merge").unwrap();
-    scenario.vehicles[1].driver = Driver::Planner("no-such-planner".into());
+    scenario.vehicles[1].driver = Driver::planner("no-such-planner");
     let err = run_instance(
         &scenario,
         &InstanceOptions::default(),

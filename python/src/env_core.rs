@@ -187,9 +187,12 @@ impl EnvCore {
         let mut instance = self.scenario.instance(seed);
         for (index, spec) in instance.vehicles.iter_mut().enumerate() {
             if index == self.agent {
-                spec.driver = Driver::Planner(EXTERNAL_PLANNER.into());
-            } else if let (Some(name), Driver::Planner(_)) = (&self.planner, &spec.driver) {
-                spec.driver = Driver::Planner(name.clone());
+                spec.driver = Driver::planner(EXTERNAL_PLANNER);
+            } else if let (Some(planner), Driver::Planner { name, .. }) =
+                (&self.planner, &mut spec.driver)
+            {
+                // The vehicle keeps its own parameters (as `--planner` does).
+                name.clone_from(planner);
             }
         }
         let agent_spec = &instance.vehicles[self.agent];

@@ -348,7 +348,7 @@ pub fn ego_of(
         y_offset_m: d_m,
         speed_mps: state.velocity_mps,
         target_speed_mps,
-        driver: Driver::Planner(EGO_PLANNER.into()),
+        driver: Driver::planner(EGO_PLANNER),
         connected: true,
         goal: Some(goal),
         route,

@@ -207,12 +207,10 @@ impl Scenario {
             message: e.to_string().trim_end().to_string(),
         };
         let table: toml::Table = toml::from_str(text).map_err(parse_error)?;
-        // A vehicle's `driver = { planner = …, params = { … } }` (planner_tables.rs): the
-        // typed reading sees the text without its `params`.
-        let (without_params, vehicle_params) =
-            planner_tables::strip_driver_params(&table, text, origin)?;
+        // A vehicle's `driver = { planner = …, params = { … } }` (planner_tables.rs): its
+        // shape, with the line of what is wrong, before the typed reading.
+        planner_tables::check_driver_params(&table, text, origin)?;
         let full_text = text;
-        let text = without_params.as_str();
         // `[sim.road] commonroad = …` (commonroad_toml.rs): read without those keys.
         let source = crate::commonroad_toml::road_source(&table, text, origin)?;
         let stripped;
@@ -236,16 +234,9 @@ impl Scenario {
         }
         // `[sim.lane_road] opendrive = { file = … }`: read once, relative to the TOML.
         crate::opendrive_source::read_opendrive_source(&mut scenario, base, origin, Some(text))?;
-        // The PF planners' tables as written, to apply on top of the parameter set; a
-        // vehicle's own parameters by its name.
+        // The PF planners' tables as written, to apply on top of the parameter set.
         scenario.set_source(origin, full_text);
         scenario.take_pf_tables(&table, origin, full_text)?;
-        for (i, params) in vehicle_params {
-            if let Some(vehicle) = scenario.vehicles.get(i) {
-                let name = vehicle.name.clone();
-                scenario.sim.vehicle_planner_params.insert(name, params);
-            }
-        }
         scenario.apply_parameter_set(origin, Some(full_text))?;
         if source.is_none() {
             lane_road_checks::check_one_road(&table, &scenario, origin, text)?;
@@ -603,17 +594,6 @@ impl Scenario {
                 sim.remove("planner");
             } else {
                 sim.insert("planner".into(), toml::Value::Table(differing));
-            }
-        }
-        // Each vehicle's own planner parameters, back in its driver table.
-        if let Some(vehicles) = table.get_mut("vehicles").and_then(|v| v.as_array_mut()) {
-            for (vehicle, spec) in vehicles.iter_mut().zip(&self.vehicles) {
-                let Some(params) = self.sim.vehicle_planner_params.get(&spec.name) else {
-                    continue;
-                };
-                if let Some(driver) = vehicle.get_mut("driver").and_then(|d| d.as_table_mut()) {
-                    driver.insert("params".into(), toml::Value::Table(params.clone()));
-                }
             }
         }
         toml::to_string(&table).map_err(|e| error(e.to_string()))

@@ -142,9 +142,10 @@ fn a_vehicle_s_params_give_its_planner_its_own_values() {
     let scenario = load(&text).unwrap();
     // The scenario-level value stays the table's; the ego's own table is kept apart.
     assert_eq!(scenario.sim.planner.interaction_weight, 9.0);
-    let own = &scenario.sim.vehicle_planner_params["ego"];
+    let own = scenario.vehicles[0].driver.params().unwrap();
+    assert_eq!(scenario.vehicles[0].name, "ego");
     assert_eq!(own["interaction_weight"].as_float(), Some(6.0));
-    assert!(!scenario.sim.vehicle_planner_params.contains_key("obstacle"));
+    assert_eq!(scenario.vehicles[1].driver.params(), None);
     // The ego's planner gets the scenario's values with its own on top.
     let registry = BehaviourRegistry::builtin();
     let parsed = registry
@@ -157,10 +158,7 @@ fn a_vehicle_s_params_give_its_planner_its_own_values() {
     assert_eq!(params.step_time_s, scenario.sim.planner.step_time_s);
     // Written back as TOML, it reads back the same.
     let again = load(&scenario.to_toml().unwrap()).unwrap();
-    assert_eq!(
-        again.sim.vehicle_planner_params,
-        scenario.sim.vehicle_planner_params
-    );
+    assert_eq!(again.vehicles, scenario.vehicles);
     assert_eq!(again.sim.planner, scenario.sim.planner);
 }
 
@@ -260,7 +258,7 @@ fn a_user_planner_s_table_is_read_by_its_own_type_and_checked_with_lines() {
     let scenario = load(&text).unwrap();
     let registry = user_registry();
     scenario.check_planners(&registry).unwrap();
-    let own = scenario.sim.vehicle_planner_params.get("ego");
+    let own = scenario.vehicles[0].driver.params();
     let parsed = registry
         .parse_params("cruise", &scenario.sim, own)
         .unwrap()

@@ -46,7 +46,6 @@ pub fn behaviour_of(
 ) -> Result<Box<dyn Behaviour>, SimError> {
     // The planner's own parameters (`crate::planner_params`): its scenario table overlaid by
     // the vehicle's `driver.params`, read by its schema.
-    let vehicle_params = config.vehicle_planner_params.get(&spec.name);
     let params_of = |name: &str, own: Option<&ParamsTable>| {
         registry
             .parse_params(name, config, own)
@@ -62,10 +61,10 @@ pub fn behaviour_of(
         registry.create(name, &input)
     };
     Ok(match &spec.driver {
-        Driver::Planner(name) => {
+        Driver::Planner { name, params } => {
             let name = planner_override.unwrap_or(name);
             let params = if registry.contains(name) {
-                params_of(name, vehicle_params)?
+                params_of(name, params.as_ref())?
             } else {
                 None // `create` names the unknown planner
             };

@@ -1,5 +1,7 @@
 //! What a simulation is made of: the shared settings and the vehicles to spawn.
 
+mod driver;
+
 use std::collections::BTreeMap;
 
 use planner::{MergeRoad, PlannerParams, SpeedProfile};
@@ -8,6 +10,8 @@ use vehicles::TrackerParams;
 
 use mergesim_types::lanes::LaneId;
 use mergesim_types::{Bound, bounds};
+
+pub use driver::Driver;
 
 use crate::error::SimError;
 use crate::goal::Goal;
@@ -52,18 +56,13 @@ pub struct SimConfig {
     /// `[sim.planners.pf]` (alias `[sim.planner]`), `[sim.planners.pf-iso]` and
     /// `[sim.planners.pf-sp]` tables on top (the scenario loader merges them;
     /// `planner::params_tables`). A vehicle's `driver = { params = … }` gives its own planner
-    /// its own copy ([`SimConfig::vehicle_planner_params`]); everything else that reads this
+    /// its own copy (`Driver::Planner::params`); everything else that reads this
     /// (V2V horizon, metrics, the field images, …) reads this scenario-level value.
     pub planner: PlannerParams,
     /// Each other planner's own table, by registered name (`[sim.planners.NAME]`): read by the
     /// planner's schema when its vehicles are built (`crate::planner_params`).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub planners: BTreeMap<String, ParamsTable>,
-    /// A vehicle's own planner parameters (`driver = { planner = "NAME", params = { … } }`),
-    /// by vehicle name, overlaying the scenario's table of that planner key by key: filled by
-    /// the scenario loader, never written under `[sim]`.
-    #[serde(skip)]
-    pub vehicle_planner_params: BTreeMap<String, ParamsTable>,
     /// Path / speed tracker.
     pub tracker: TrackerParams,
     /// Collision, gap and TTC thresholds.
@@ -92,7 +91,6 @@ impl Default for SimConfig {
             v2v: V2vParams::default(),
             planner: PlannerParams::default(),
             planners: BTreeMap::new(),
-            vehicle_planner_params: BTreeMap::new(),
             tracker: TrackerParams::default(),
             safety: SafetyParams::default(),
             idm: IdmParams::default(),
@@ -225,31 +223,6 @@ impl SimConfig {
         self.planner.validate()?;
         Ok(())
     }
-}
-
-/// How a vehicle decides its path and speed.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Driver {
-    /// A planner by its registered name: `pf-cs`, `pf-sp`, `pf-sp-eq10`, `pf-iso`,
-    /// `pf-iso-pred`, or a user's (`crate::registry`).
-    Planner(String),
-    /// The path of a potential-field planner (`path_planner`), the speeds of a prescribed
-    /// time → speed profile (`speed_profile = [[t_s, speed_mps], …]`, linear in between, held
-    /// outside). Not changed by `--planner`. Tests whether a given speed profile (e.g. the
-    /// paper's pre-braking) changes the winding, without the speed optimiser.
-    Prescribed {
-        /// Planner (registered name) whose path the vehicle follows.
-        path_planner: String,
-        /// The speeds.
-        speed_profile: SpeedProfile,
-    },
-    /// No planner: holds its lane centre and target speed, blind to others (for deliberately
-    /// unsafe tests).
-    LaneKeeping,
-    /// A human driver: Intelligent Driver Model car following (Treiber et al. 2000) with lane
-    /// keeping; never changes lanes, never connected.
-    Idm,
 }
 
 /// One vehicle to spawn.

@@ -2,9 +2,11 @@
 //! of the tick timed with a monotonic clock. Off by default (the clock reads cost ≈ 1 % of a
 //! two-vehicle run); wall-clock figures are not part of the determinism contract.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
+
+use crate::observer::TickObserver;
 
 /// A phase of the tick.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,44 +57,18 @@ impl Phase {
     }
 }
 
-/// Accumulates wall time per phase when enabled; every call is a no-op otherwise.
+/// The built-in observer of the tick's phase times (`RunOptions::profile`): sums each phase's
+/// wall time over the run ([`TickObserver::on_phase`]); the world reads the clock only while an
+/// observer asks for phase times.
 #[derive(Clone, Debug, Default)]
-pub struct Profiler {
-    enabled: bool,
+pub struct ProfileObserver {
     totals: [Duration; Phase::ALL.len()],
 }
 
-impl Profiler {
-    /// A profiler that measures (`enabled`) or does nothing.
-    pub fn new(enabled: bool) -> Self {
-        Self {
-            enabled,
-            totals: Default::default(),
-        }
-    }
-
-    /// Now, if measuring.
-    pub fn start(&self) -> Option<Instant> {
-        self.enabled.then(Instant::now)
-    }
-
-    /// Adds the time since `started` (from [`Self::start`]) to `phase`.
-    pub fn stop(&mut self, phase: Phase, started: Option<Instant>) {
-        if let Some(started) = started {
-            self.add(phase, started.elapsed());
-        }
-    }
-
-    /// Adds `elapsed` to `phase`.
-    pub fn add(&mut self, phase: Phase, elapsed: Duration) {
-        if self.enabled {
-            self.totals[phase as usize] += elapsed;
-        }
-    }
-
-    /// The report (None when not measuring).
-    pub fn report(&self) -> Option<ProfileReport> {
-        self.enabled.then(|| ProfileReport {
+impl ProfileObserver {
+    /// The report: every phase's total, in tick order.
+    pub fn report(&self) -> ProfileReport {
+        ProfileReport {
             phases: Phase::ALL
                 .iter()
                 .map(|&p| PhaseTime {
@@ -100,7 +76,17 @@ impl Profiler {
                     wall_s: self.totals[p as usize].as_secs_f64(),
                 })
                 .collect(),
-        })
+        }
+    }
+}
+
+impl TickObserver for ProfileObserver {
+    fn wants_phase_times(&self) -> bool {
+        true
+    }
+
+    fn on_phase(&mut self, phase: Phase, wall: Duration) {
+        self.totals[phase as usize] += wall;
     }
 }
 
@@ -148,15 +134,13 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_disabled_profiler_measures_nothing_and_an_enabled_one_adds_up() {
-        let mut off = Profiler::new(false);
-        assert!(off.start().is_none());
-        off.add(Phase::Physics, Duration::from_millis(5));
-        assert!(off.report().is_none());
-        let mut on = Profiler::new(true);
-        on.add(Phase::Physics, Duration::from_millis(5));
-        on.add(Phase::Planning, Duration::from_millis(15));
-        let report = on.report().unwrap();
+    fn the_profile_observer_adds_up_each_phase() {
+        let mut on = ProfileObserver::default();
+        assert!(on.wants_phase_times());
+        on.on_phase(Phase::Physics, Duration::from_millis(5));
+        on.on_phase(Phase::Planning, Duration::from_millis(10));
+        on.on_phase(Phase::Planning, Duration::from_millis(5));
+        let report = on.report();
         assert!((report.total_s() - 0.020).abs() < 1e-12);
         assert!(report.table().contains("planning"));
         assert!(report.table().contains("75.0 %"), "{}", report.table());

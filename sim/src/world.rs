@@ -9,7 +9,7 @@
 //! Same configuration + same seed ⇒ bitwise identical results: vehicles are visited by index,
 //! every map is ordered, and the only randomness (V2V drops) comes from a seeded stream.
 
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use mergesim_types::{PathPoint, SharedLocalPath, VehicleId};
 use vehicles::{Kinematics, PhysicsWorld};
@@ -23,7 +23,7 @@ use crate::metrics::{MetricsSample, VehicleMetrics};
 use crate::observer::{TickObserver, VehicleView};
 use crate::outcome::RunOutcome;
 use crate::planner_stats::PlannerStatsObserver;
-use crate::profile::{Phase, Profiler};
+use crate::profile::{Phase, ProfileObserver};
 use crate::recording::Recorder;
 use crate::recording_observer::RecordingObserver;
 use crate::registry::BehaviourRegistry;
@@ -78,7 +78,10 @@ pub struct World {
     steps_per_safety: u64,
     reported_collisions: usize,
     reported_edge_contacts: usize,
-    profiler: Profiler,
+    /// The built-in phase-time observer (`RunOptions::profile`).
+    profile: Option<ProfileObserver>,
+    /// Whether some observer wants phase times (the clock is read only then).
+    timing: bool,
     planning_pool: Option<std::sync::Arc<rayon::ThreadPool>>,
     /// Per vehicle: when it reached its goal (`crate::goal`; `world/goals.rs`).
     goal_times: Vec<Option<f64>>,
@@ -179,7 +182,8 @@ impl World {
             events: Vec::new(),
             planner_stats: PlannerStatsObserver::default(),
             step_index: 0,
-            profiler: Profiler::new(options.profile),
+            profile: options.profile.then(ProfileObserver::default),
+            timing: options.profile,
             planning_pool: None,
             reported_collisions: 0,
             reported_edge_contacts: 0,
@@ -190,6 +194,7 @@ impl World {
 
     /// Adds an observer, called after the built-in ones.
     pub fn add_observer(&mut self, observer: Box<dyn TickObserver>) {
+        self.timing |= observer.wants_phase_times();
         self.observers.push(observer);
     }
 
@@ -265,9 +270,9 @@ impl World {
     pub fn step(&mut self) -> Result<(), SimError> {
         let t_s = self.time_s();
         // 1. V2V delivery.
-        let started = self.profiler.start();
+        let started = self.clock();
         self.bus.deliver(t_s);
-        self.profiler.stop(Phase::V2v, started);
+        self.phase_since(Phase::V2v, started)?;
         // 2. Planning, by id.
         if self.step_index.is_multiple_of(self.steps_per_plan) {
             // Timed inside (the observers' share goes to metrics and recording).
@@ -277,7 +282,7 @@ impl World {
         let dt_s = self.physics.dt_s();
         let (mut tracking, mut forces) = (Duration::ZERO, Duration::ZERO);
         for agent in &mut self.agents {
-            let started = self.profiler.start();
+            let started = self.timing.then(Instant::now);
             let kin = agent.vehicle.kinematics(&self.physics);
             if agent.path.is_empty() {
                 let v = agent.spec.target_speed_mps;
@@ -292,7 +297,7 @@ impl World {
             }
             let controls = agent.tracker.update(&kin, &agent.path, dt_s);
             agent.vehicle.set_controls(controls);
-            let tracked = self.profiler.start();
+            let tracked = self.timing.then(Instant::now);
             agent
                 .vehicle
                 .apply_forces(&mut self.physics, self.config.mu);
@@ -301,22 +306,22 @@ impl World {
                 forces += tracked.elapsed();
             }
         }
-        self.profiler.add(Phase::Tracking, tracking);
-        self.profiler.add(Phase::TireForces, forces);
-        let started = self.profiler.start();
+        self.phase_took(Phase::Tracking, tracking)?;
+        self.phase_took(Phase::TireForces, forces)?;
+        let started = self.clock();
         // Recorded traffic: kinematic targets for this step (`recorded` module doc).
         if !self.recorded.is_empty() {
             self.advance_recorded(t_s)?;
         }
         self.physics.step();
-        self.profiler.stop(Phase::Physics, started);
+        self.phase_since(Phase::Physics, started)?;
         self.step_index += 1;
         let t_s = self.time_s();
         // 5. Safety checks.
         let need_log = self.step_index.is_multiple_of(self.steps_per_log);
         let need_safety = self.step_index.is_multiple_of(self.steps_per_safety);
         if need_safety || need_log {
-            let started = self.profiler.start();
+            let started = self.clock();
             let kins: Vec<Kinematics> = self
                 .agents
                 .iter()
@@ -348,7 +353,7 @@ impl World {
                     })?;
                 self.report_new_collisions()?;
             }
-            self.profiler.stop(Phase::Safety, started);
+            self.phase_since(Phase::Safety, started)?;
             // 6. Observers (goals first: their events are in this instant's log).
             if need_log {
                 self.check_goals(t_s, &kins)?;
@@ -358,11 +363,41 @@ impl World {
         Ok(())
     }
 
+    /// Now, if some observer wants phase times.
+    fn clock(&self) -> Option<Instant> {
+        self.timing.then(Instant::now)
+    }
+
+    /// Tells the observers that want phase times that `phase` took the time since `started`
+    /// (from [`Self::clock`]).
+    fn phase_since(&mut self, phase: Phase, started: Option<Instant>) -> Result<(), SimError> {
+        match started {
+            Some(started) => self.phase_took(phase, started.elapsed()),
+            None => Ok(()),
+        }
+    }
+
+    /// Tells the observers that want phase times that `phase` took `wall`.
+    fn phase_took(&mut self, phase: Phase, wall: Duration) -> Result<(), SimError> {
+        if !self.timing {
+            return Ok(());
+        }
+        self.each_observer(|o| {
+            if o.wants_phase_times() {
+                o.on_phase(phase, wall);
+            }
+            Ok(())
+        })
+    }
+
     /// Every observer, built-in first.
     fn each_observer(
         &mut self,
         mut f: impl FnMut(&mut dyn TickObserver) -> Result<(), SimError>,
     ) -> Result<(), SimError> {
+        if let Some(profile) = self.profile.as_mut() {
+            f(profile)?;
+        }
         f(&mut self.planner_stats)?;
         f(&mut self.run_log)?;
         f(&mut self.recording)?;

@@ -69,7 +69,7 @@ fn events_of(config: SimConfig, x_m: f64) -> (Vec<String>, u32) {
         y_offset_m: 0.0,
         speed_mps: 12.0,
         target_speed_mps: 12.0,
-        driver: Driver::Planner("weave".into()),
+        driver: Driver::planner("weave"),
         connected: false,
         goal: None,
         route: None,

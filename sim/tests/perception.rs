@@ -78,7 +78,7 @@ fn seen_by_the_first(config: SimConfig) -> Seen {
             y_offset_m: 0.0,
             speed_mps: 15.0,
             target_speed_mps: 15.0,
-            driver: Driver::Planner("witness".into()),
+            driver: Driver::planner("witness"),
             connected: true,
             goal: None,
             route: None,

@@ -218,7 +218,7 @@ fn a_recorded_vehicle_is_a_planners_neighbour_during_its_span_only() {
         ],
         ..recorded("cr-1", Vec::new())
     };
-    let specs = [spec("ego", 100.0, 10.0, Driver::Planner("witness".into()))];
+    let specs = [spec("ego", 100.0, 10.0, Driver::planner("witness"))];
     World::with_registry(
         config(3.0, TrafficMode::Replay, vec![r]),
         &specs,
@@ -436,7 +436,7 @@ fn run_on(threads: usize) -> RunOutcome {
         },
     ];
     let specs = [
-        spec("ego", 40.0, 12.0, Driver::Planner("pf-iso".into())),
+        spec("ego", 40.0, 12.0, Driver::planner("pf-iso")),
         VehicleSpec {
             lane: Lane::Lower.into(),
             ..spec("other", 20.0, 12.0, Driver::Idm)

@@ -5,7 +5,7 @@
 //! `planner::params_tables`) are views on the one `PlannerParams`: the loader merges them into
 //! the scenario's `planner_overrides`, applied on top of the `--params` set. Any other name's
 //! table stays in `sim.planners` for that planner's schema. A vehicle's `params` overlay its
-//! planner's table for that vehicle alone (`sim.vehicle_planner_params`).
+//! planner's table for that vehicle alone (`sim::Driver::Planner::params`).
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -13,7 +13,6 @@ use std::sync::Arc;
 use planner::params_tables::{self, PF_TABLE, PF_TABLES};
 use sim::registry::BehaviourRegistry;
 use sim::{Driver, ParamsError};
-use toml::de::{DeTable, DeValue};
 
 use super::{Line, Scenario, ScenarioError, ScenarioSource};
 use crate::source_location::line_of;
@@ -38,17 +37,17 @@ fn invalid(
     }
 }
 
-/// The text with every vehicle's `driver.params` blanked out (spaces, so every other value
-/// keeps its line and column), and those tables by vehicle index. Only the inline form
-/// `driver = { planner = "NAME", params = { … } }` is read.
-pub(crate) fn strip_driver_params(
+/// Checks the shape of every vehicle's `driver.params` in the untyped table: a table, beside a
+/// planner (`driver = { planner = "NAME", params = { … } }` or a `[vehicles.driver.params]`
+/// header); the error names the line and field. (The typed reading refuses these too, without
+/// the field.)
+pub(crate) fn check_driver_params(
     table: &toml::Table,
     text: &str,
     origin: &str,
-) -> Result<(String, BTreeMap<usize, toml::Table>), ScenarioError> {
-    let mut found = BTreeMap::new();
+) -> Result<(), ScenarioError> {
     let Some(vehicles) = table.get("vehicles").and_then(|v| v.as_array()) else {
-        return Ok((text.to_string(), found));
+        return Ok(());
     };
     for (i, vehicle) in vehicles.iter().enumerate() {
         let Some(driver) = vehicle.get("driver").and_then(|d| d.as_table()) else {
@@ -59,7 +58,7 @@ pub(crate) fn strip_driver_params(
         };
         let at = path(&["vehicles", &i.to_string(), "driver", "params"]);
         let field = format!("vehicles[#{i}].driver.params");
-        let Some(params) = params.as_table() else {
+        if !params.is_table() {
             return Err(invalid(
                 origin,
                 Some(text),
@@ -67,7 +66,7 @@ pub(crate) fn strip_driver_params(
                 field,
                 "must be a table of the planner's parameters".into(),
             ));
-        };
+        }
         if !driver.get("planner").is_some_and(|p| p.is_str()) {
             return Err(invalid(
                 origin,
@@ -77,97 +76,8 @@ pub(crate) fn strip_driver_params(
                 "params go with a planner: driver = { planner = \"NAME\", params = { … } }".into(),
             ));
         }
-        found.insert(i, params.clone());
     }
-    if found.is_empty() {
-        return Ok((text.to_string(), found));
-    }
-    let mut bytes = text.as_bytes().to_vec();
-    let root = DeTable::parse(text).map_err(|e| ScenarioError::Parse {
-        origin: origin.to_string(),
-        message: e.to_string(),
-    })?;
-    let root = DeValue::Table(root.into_inner());
-    for &i in found.keys() {
-        let field = format!("vehicles[#{i}].driver.params");
-        let at = path(&["vehicles", &i.to_string(), "driver", "params"]);
-        let driver = root
-            .get("vehicles")
-            .and_then(|v| v.get_ref().get(i))
-            .and_then(|v| v.get_ref().get("driver"));
-        // (key span, value span, end of the last value inside a `[vehicles.driver.params]`
-        // table written as a header).
-        let entry = driver.and_then(|d| match d.get_ref() {
-            DeValue::Table(t) => t
-                .iter()
-                .find(|(k, _)| k.get_ref().as_ref() == "params")
-                .map(|(k, v)| {
-                    let last_end = match v.get_ref() {
-                        DeValue::Table(inner) => inner
-                            .iter()
-                            .map(|(ik, iv)| ik.span().end.max(iv.span().end))
-                            .max(),
-                        _ => None,
-                    };
-                    (k.span(), v.span(), last_end)
-                }),
-            _ => None,
-        });
-        let Some((key, value, last_end)) = entry else {
-            return Err(invalid(
-                origin,
-                Some(text),
-                &[at],
-                field,
-                "cannot find it in the text".into(),
-            ));
-        };
-        let line_start = text[..key.start].rfind('\n').map_or(0, |i| i + 1);
-        let inline = text.as_bytes().get(value.start) == Some(&b'{');
-        let header = text[line_start..].trim_start().starts_with('[');
-        if !inline && !header {
-            return Err(invalid(
-                origin,
-                Some(text),
-                &[at],
-                field,
-                "write a vehicle's planner parameters as an inline table (driver = { planner = \
-                 \"NAME\", params = { … } }) or under a [vehicles.driver.params] header"
-                    .into(),
-            ));
-        }
-        let blank = |bytes: &mut Vec<u8>, from: usize, to: usize| {
-            for b in &mut bytes[from..to] {
-                if *b != b'\n' && *b != b'\r' {
-                    *b = b' ';
-                }
-            }
-        };
-        if !inline {
-            // The header line and the table's entries, to the end of its last entry's line.
-            let end = last_end.unwrap_or(key.end).max(key.end);
-            let end = text[end..].find('\n').map_or(text.len(), |i| end + i);
-            blank(&mut bytes, line_start, end);
-            continue;
-        }
-        blank(&mut bytes, key.start, value.end);
-        // The comma that separated it from its neighbour inside the inline table.
-        let before = text[..key.start].trim_end();
-        if before.ends_with(',') {
-            blank(&mut bytes, before.len() - 1, before.len());
-        } else {
-            let after = &text[value.end..];
-            let skipped = after.len() - after.trim_start().len();
-            if after.trim_start().starts_with(',') {
-                blank(&mut bytes, value.end + skipped, value.end + skipped + 1);
-            }
-        }
-    }
-    let stripped = String::from_utf8(bytes).map_err(|e| ScenarioError::Parse {
-        origin: origin.to_string(),
-        message: e.to_string(),
-    })?;
-    Ok((stripped, found))
+    Ok(())
 }
 
 impl Scenario {
@@ -336,10 +246,11 @@ impl Scenario {
             })?;
         }
         for (i, vehicle) in self.vehicles.iter().enumerate() {
-            let Some(own) = self.sim.vehicle_planner_params.get(&vehicle.name) else {
-                continue;
-            };
-            let Driver::Planner(name) = &vehicle.driver else {
+            let Driver::Planner {
+                name,
+                params: Some(own),
+            } = &vehicle.driver
+            else {
                 continue;
             };
             let own_at = |key: Option<&str>| {

@@ -58,13 +58,13 @@ impl World {
                 received: &received[i],
             })
             .collect();
-        let started = self.profiler.start();
+        let started = self.timing.then(Instant::now);
         self.run_log.on_log(t_s, &views)?;
         for observer in &mut self.observers {
             observer.on_log(t_s, &views)?;
         }
-        self.profiler.stop(Phase::Metrics, started);
-        let started = self.profiler.start();
+        let metrics = started.map(|s| s.elapsed());
+        let started = self.timing.then(Instant::now);
         self.recording.on_log(t_s, &views)?;
         if !self.recorded.is_empty() {
             // Recorded traffic: drawn, not in the time series (`recorded` module doc).
@@ -89,7 +89,12 @@ impl World {
                 }));
             }
         }
-        self.profiler.stop(Phase::Recording, started);
+        let recording = started.map(|s| s.elapsed());
+        drop(views);
+        if let (Some(metrics), Some(recording)) = (metrics, recording) {
+            self.phase_took(Phase::Metrics, metrics)?;
+            self.phase_took(Phase::Recording, recording)?;
+        }
         Ok(())
     }
 
@@ -115,7 +120,7 @@ impl World {
             v2v,
             time_series: self.run_log.into_time_series(),
             recorded_track: self.recorded_track.unwrap_or_default(),
-            profile: self.profiler.report(),
+            profile: self.profile.as_ref().map(ProfileObserver::report),
             events: self.events,
             goals,
         })

@@ -27,7 +27,7 @@ use crate::spatial::neighbours_within;
 
 impl World {
     pub(super) fn plan_all(&mut self, t_s: f64) -> Result<(), SimError> {
-        let started = self.profiler.start();
+        let started = self.clock();
         let (mut metrics, mut recording) = (Duration::ZERO, Duration::ZERO);
         let kins: Vec<Kinematics> = self
             .agents
@@ -173,13 +173,13 @@ impl World {
                     plan_time_us: elapsed_us,
                     optimiser,
                 };
-                let observed = self.profiler.start();
+                let observed = self.timing.then(Instant::now);
                 self.planner_stats.on_plan(t_s, &view)?;
                 self.run_log.on_plan(t_s, &view)?;
                 for observer in &mut self.observers {
                     observer.on_plan(t_s, &view)?;
                 }
-                let recorded = self.profiler.start();
+                let recorded = self.timing.then(Instant::now);
                 self.recording.on_plan(t_s, &view)?;
                 if let (Some(observed), Some(recorded)) = (observed, recorded) {
                     metrics += recorded - observed;
@@ -207,12 +207,10 @@ impl World {
             }
         }
         if let Some(started) = started {
-            self.profiler.add(
-                Phase::Planning,
-                started.elapsed().saturating_sub(metrics + recording),
-            );
-            self.profiler.add(Phase::Metrics, metrics);
-            self.profiler.add(Phase::Recording, recording);
+            let planning = started.elapsed().saturating_sub(metrics + recording);
+            self.phase_took(Phase::Planning, planning)?;
+            self.phase_took(Phase::Metrics, metrics)?;
+            self.phase_took(Phase::Recording, recording)?;
         }
         Ok(())
     }
