@@ -74,7 +74,7 @@ fn universal_field_gradient_matches_finite_differences_on_the_curved_merge() {
                 neighbour(2, on_lane(&road, ending, 100.0, -0.2, -0.03, 22.0)),
             ];
             let field = PotentialField::new(
-                &params,
+                &(&params).into(),
                 &geometry,
                 0,
                 &ego,
@@ -158,9 +158,16 @@ fn a_rotated_copy_of_the_road_gives_the_same_field() {
             .iter()
             .map(|n| neighbour(n.id, rotate_state(n.state)))
             .collect();
-        let fa = PotentialField::new(&params, &ga, 0, &ego, &VehicleShape::default(), &others);
+        let fa = PotentialField::new(
+            &(&params).into(),
+            &ga,
+            0,
+            &ego,
+            &VehicleShape::default(),
+            &others,
+        );
         let fb = PotentialField::new(
-            &params,
+            &(&params).into(),
             &gb,
             0,
             &rotate_state(ego),
