@@ -11,7 +11,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use mergesim_types::lanes::{LaneRoad, THROUGH_LANE_ID, curved_merge_spec};
 use planner::attractive_field::AttractiveField;
 use planner::lane_road_field::{LaneRoadField, LaneRoadGeometry};
-use planner::road_field::RoadField;
+use planner::road_field::{RoadField, RoadFieldParams};
 use planner::{MergeRoad, PlannerParams, VehicleShape};
 
 /// 64 points over the first 400 m, across both lanes (the taper included).
@@ -39,7 +39,7 @@ fn bench(c: &mut Criterion) {
     };
     let lanes = road.lane_road().expect("valid road");
     let geometry = LaneRoadGeometry::new(&lanes);
-    let field = LaneRoadField::new(&geometry, &p, half_width_m);
+    let field = LaneRoadField::new(&geometry, &RoadFieldParams::from(&p), half_width_m);
     let target = lanes.lane(THROUGH_LANE_ID).expect("lane").centreline();
     // The moving target's pull through the prepared frame of the through lane, as the
     // planner's `PotentialField::moving_target_gradient` computes it.
@@ -80,7 +80,8 @@ fn bench(c: &mut Criterion) {
     });
     let curved = LaneRoad::new(&curved_merge_spec(&road, 300.0).expect("valid")).expect("valid");
     let curved_geometry = LaneRoadGeometry::new(&curved);
-    let curved_field = LaneRoadField::new(&curved_geometry, &p, half_width_m);
+    let curved_field =
+        LaneRoadField::new(&curved_geometry, &RoadFieldParams::from(&p), half_width_m);
     let curved_lane = curved.lane(THROUGH_LANE_ID).expect("lane");
     let curved_pts =
         points(|x, y| curved_lane.point(x + 50.0, y - road.lane_center_y_m(planner::Lane::Upper)));

@@ -8,6 +8,17 @@
 //! the pull is the constant λ·look-ahead while stepping (Eq. 7), and the fixed-target form
 //! below is what is drawn (target = ego X + look-ahead).
 
+/// The numbers of Eq. 1 (λ and the moving target's look-ahead), built once from
+/// `PlannerParams` (`derived_params`); the pull λ·look-ahead is the unit of force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AttractionParams {
+    /// λ, slope scale of U_AT = ½ λ (X − X_tar)² (1/m²; `attractive_gain_per_m2`).
+    pub gain_per_m2: f64,
+    /// Distance of the moving target X_tar ahead of the point being stepped (m;
+    /// `target_lookahead_m`).
+    pub lookahead_m: f64,
+}
+
 /// The attractive field of Eq. 1 with a target at `target_x_m`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AttractiveField {

@@ -32,7 +32,35 @@ use nalgebra::{Matrix4, Vector4};
 
 use crate::clarabel_setup::{ProgramSettings, new_solver, solve_checked};
 use crate::error::PlannerError;
-use crate::params::PlannerParams;
+
+/// The limits behind Eq. 9a's coefficient bounds (module doc), built once from
+/// `PlannerParams` (`derived_params`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CubicLimits {
+    /// offset_max, bound on |a0|, the lateral offset of the path at the vehicle (m).
+    pub max_offset_m: f64,
+    /// ψ_max, bound on the path heading at the vehicle, relative to it (rad): |a1| ≤ S tan ψ_max.
+    pub max_heading_rad: f64,
+    /// κ_max, bound on the curvature at the vehicle (1/m): |a2| ≤ S² κ_max / 2.
+    pub max_curvature_per_m: f64,
+    /// κ'_max, bound on the curvature rate (1/m²): |a3| ≤ S³ κ'_max / 6.
+    pub max_curvature_rate_per_m2: f64,
+}
+
+/// Everything the fit of Eqs. 8–9 reads (module doc), built once from `PlannerParams`
+/// (`derived_params`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CubicFitParams {
+    /// Weight of the vehicle's own position (0, 0) as a data point (waypoints weigh 1): the
+    /// diagonal of W in Eq. 9 (`cubic_origin_weight`).
+    pub origin_weight: f64,
+    /// The limits of Eq. 9a.
+    pub limits: CubicLimits,
+    /// Clarabel's `max_iter` for the QP of Eq. 9 (`solver_max_iterations`).
+    pub solver_max_iterations: u32,
+    /// Clarabel's tolerances for the QP of Eq. 9 (`solver_tolerance`).
+    pub solver_tolerance: f64,
+}
 
 /// Box bounds on the coefficients (Eq. 9a).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,13 +74,13 @@ pub struct CoefficientBounds {
 impl CoefficientBounds {
     /// Symmetric bounds from the heading / curvature / curvature-rate limits for a path whose
     /// x is scaled by `x_scale_m` (module doc).
-    pub fn from_limits(params: &PlannerParams, x_scale_m: f64) -> Self {
+    pub fn from_limits(limits: &CubicLimits, x_scale_m: f64) -> Self {
         let s = x_scale_m;
         let upper = [
-            params.cubic_max_offset_m,
-            s * params.cubic_max_heading_rad.tan(),
-            s * s * params.cubic_max_curvature_per_m / 2.0,
-            s * s * s * params.cubic_max_curvature_rate_per_m2 / 6.0,
+            limits.max_offset_m,
+            s * limits.max_heading_rad.tan(),
+            s * s * limits.max_curvature_per_m / 2.0,
+            s * s * s * limits.max_curvature_rate_per_m2 / 6.0,
         ];
         Self {
             lower: upper.map(|u| -u),
@@ -243,7 +271,7 @@ impl CubicPath {
 /// waypoints do not advance along the vehicle's heading (a cubic η(ξ) cannot hold them) or the
 /// QP fails.
 pub fn fit_path_cubic(
-    params: &PlannerParams,
+    params: &CubicFitParams,
     origin_xy_m: [f64; 2],
     yaw_rad: f64,
     waypoints: &[[f64; 2]],
@@ -280,13 +308,13 @@ pub fn fit_path_cubic(
     let mut ws = Vec::with_capacity(local.len() + 1);
     xs.push(0.0);
     ys.push(0.0);
-    ws.push(params.cubic_origin_weight);
+    ws.push(params.origin_weight);
     for p in &local {
         xs.push(p[0] / x_scale_m);
         ys.push(p[1]);
         ws.push(1.0);
     }
-    let bounds = CoefficientBounds::from_limits(params, x_scale_m);
+    let bounds = CoefficientBounds::from_limits(&params.limits, x_scale_m);
     let (coefficients, method) = fit_bounded_cubic(
         &xs,
         &ys,
@@ -373,7 +401,7 @@ mod tests {
 
     #[test]
     fn path_fit_reproduces_a_cubic_path_in_a_rotated_vehicle_frame() {
-        let params = PlannerParams::default();
+        let params = CubicFitParams::from(&crate::params::PlannerParams::default());
         let yaw: f64 = 0.2;
         let origin = [10.0, 3.0];
         // A gentle cubic in the vehicle frame, well inside the default bounds.
@@ -419,7 +447,7 @@ mod tests {
 
     #[test]
     fn waypoints_behind_the_vehicle_are_a_typed_error() {
-        let params = PlannerParams::default();
+        let params = CubicFitParams::from(&crate::params::PlannerParams::default());
         let waypoints: Vec<[f64; 2]> = (1..=6).map(|k| [-(k as f64), 0.0]).collect();
         let err = fit_path_cubic(&params, [0.0, 0.0], 0.0, &waypoints).unwrap_err();
         assert!(matches!(err, PlannerError::SolverFailed { .. }));

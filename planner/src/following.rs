@@ -36,7 +36,6 @@
 use serde::{Deserialize, Serialize};
 
 use crate::lane_road_field::LaneRoadGeometry;
-use crate::params::PlannerParams;
 use crate::types::{Neighbour, VehicleId, VehicleShape, VehicleState};
 
 /// What a PF-ISO vehicle does in a cycle without any fresh shared path around it (module doc).
@@ -51,12 +50,31 @@ pub enum V2vLossFallback {
     RiskAwareFollowing,
 }
 
+/// The numbers of the safe-following cap and its corridor (module doc), built once from
+/// `PlannerParams` (`derived_params`). Not from the paper: Gipps (1981).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FollowingParams {
+    /// b, the deceleration both vehicles are assumed to brake at (m/s²): the speed optimiser's
+    /// own a_max (`max_accel_mps2`, the acceleration bound of Eq. 10).
+    pub decel_mps2: f64,
+    /// τ, reaction time before braking (s; `following_reaction_s`).
+    pub reaction_s: f64,
+    /// s₀, the bumper gap left at standstill (m; `following_standstill_gap_m`).
+    pub standstill_gap_m: f64,
+    /// Margin added to the half-widths of the corridor test (m; `following_lateral_margin_m`).
+    pub lateral_margin_m: f64,
+}
+
 /// Gipps' safe speed behind a leader at bumper gap `gap_m` driving at `leader_speed_mps`
 /// (module doc); 0 when even a standing start is too close.
-pub fn safe_following_speed_mps(params: &PlannerParams, gap_m: f64, leader_speed_mps: f64) -> f64 {
-    let b = params.max_accel_mps2;
-    let tau = params.following_reaction_s;
-    let room_m = gap_m - params.following_standstill_gap_m;
+pub fn safe_following_speed_mps(
+    params: &FollowingParams,
+    gap_m: f64,
+    leader_speed_mps: f64,
+) -> f64 {
+    let b = params.decel_mps2;
+    let tau = params.reaction_s;
+    let room_m = gap_m - params.standstill_gap_m;
     let radicand = b * b * tau * tau + leader_speed_mps * leader_speed_mps + 2.0 * b * room_m;
     if radicand <= 0.0 {
         return 0.0;
@@ -104,7 +122,7 @@ fn meeting_x_m(ego: &VehicleState, ego_shape: &VehicleShape, n: &Neighbour) -> f
 /// The vehicles ahead of `ego` (shape `ego_shape`) in its corridor along `path` (world points
 /// from its position on; module doc), each as (bumper gap along X (m), speed (m/s)).
 pub fn corridor_leaders(
-    params: &PlannerParams,
+    params: &FollowingParams,
     ego_id: VehicleId,
     ego: &VehicleState,
     ego_shape: &VehicleShape,
@@ -118,7 +136,7 @@ pub fn corridor_leaders(
             let half_widths_m = 0.5 * (ego_shape.width_m + n.shape.width_m);
             let in_corridor_at = |x_m: f64| {
                 path_y_at(path, x_m).is_some_and(|y| {
-                    (y - n.state.y_m).abs() < half_widths_m + params.following_lateral_margin_m
+                    (y - n.state.y_m).abs() < half_widths_m + params.lateral_margin_m
                 })
             };
             in_corridor_at(n.state.x_m) || in_corridor_at(meeting_x_m(ego, ego_shape, n))
@@ -131,7 +149,7 @@ pub fn corridor_leaders(
 /// `path` (world points from its position on), behind the nearest neighbour in its corridor;
 /// `None` when no neighbour is in it.
 pub fn following_cap_mps(
-    params: &PlannerParams,
+    params: &FollowingParams,
     ego_id: VehicleId,
     ego: &VehicleState,
     ego_shape: &VehicleShape,
@@ -145,7 +163,7 @@ pub fn following_cap_mps(
 }
 
 /// The smallest safe-following speed behind `leaders` ((gap, speed) pairs); `None` if empty.
-pub fn cap_behind(params: &PlannerParams, leaders: &[(f64, f64)]) -> Option<f64> {
+pub fn cap_behind(params: &FollowingParams, leaders: &[(f64, f64)]) -> Option<f64> {
     leaders
         .iter()
         .map(|&(gap_m, speed_mps)| safe_following_speed_mps(params, gap_m, speed_mps))
@@ -157,7 +175,7 @@ pub fn cap_behind(params: &PlannerParams, leaders: &[(f64, f64)]) -> Option<f64>
 /// bumper gap and the corridor are measured along the road, curved or not (on a straight road
 /// along +x the same figures as in world coordinates).
 pub fn corridor_leaders_in_lane_frame(
-    params: &PlannerParams,
+    params: &FollowingParams,
     road: &LaneRoadGeometry,
     ego_id: VehicleId,
     ego: &VehicleState,
@@ -188,7 +206,7 @@ pub fn corridor_leaders_in_lane_frame(
 
 /// [`following_cap_mps`] on a road of lanes ([`corridor_leaders_in_lane_frame`]).
 pub fn following_cap_in_lane_frame_mps(
-    params: &PlannerParams,
+    params: &FollowingParams,
     road: &LaneRoadGeometry,
     ego_id: VehicleId,
     ego: &VehicleState,
@@ -205,6 +223,7 @@ pub fn following_cap_in_lane_frame_mps(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::PlannerParams;
 
     fn neighbour(id: VehicleId, x_m: f64, y_m: f64, speed_mps: f64) -> Neighbour {
         Neighbour {
@@ -221,9 +240,9 @@ mod tests {
 
     #[test]
     fn gipps_speed_stops_behind_a_braking_leader() {
-        let params = PlannerParams::default();
-        let b = params.max_accel_mps2;
-        let tau = params.following_reaction_s;
+        let params = FollowingParams::from(&PlannerParams::default());
+        let b = params.decel_mps2;
+        let tau = params.reaction_s;
         for (gap_m, v_l) in [(30.0, 15.0), (10.0, 14.0), (60.0, 0.0), (3.0, 20.0)] {
             let v = safe_following_speed_mps(&params, gap_m, v_l);
             // Travelled while reacting and braking at b vs the leader's braking distance.
@@ -231,7 +250,7 @@ mod tests {
             let leader_m = v_l * v_l / (2.0 * b);
             let left_m = gap_m + leader_m - follower_m;
             assert!(
-                (left_m - params.following_standstill_gap_m).abs() < 1e-9,
+                (left_m - params.standstill_gap_m).abs() < 1e-9,
                 "gap {gap_m}, leader {v_l}: v {v}, leaves {left_m} m"
             );
         }
@@ -241,7 +260,7 @@ mod tests {
 
     #[test]
     fn only_vehicles_ahead_in_the_path_corridor_cap_the_speed() {
-        let params = PlannerParams::default();
+        let params = FollowingParams::from(&PlannerParams::default());
         let ego = VehicleState {
             x_m: 0.0,
             y_m: 1.75,
@@ -275,7 +294,7 @@ mod tests {
 
     #[test]
     fn a_car_in_the_lane_the_path_is_about_to_enter_caps_the_speed_where_it_would_be_reached() {
-        let params = PlannerParams::default();
+        let params = FollowingParams::from(&PlannerParams::default());
         let shape = VehicleShape::default();
         // The path stays in the lower lane for 40 m, then reaches the upper lane by x = 80 m.
         let merging: Vec<[f64; 2]> = (0..=20)

@@ -32,11 +32,11 @@ use std::sync::Arc;
 
 use mergesim_types::lanes::{Centreline, Divider, FramePoint, Lane, LaneId, LaneRoad, Side};
 
+use crate::attractive_field::AttractionParams;
 use crate::lane_frame::{FrameJacobian, frame_jacobian, to_world_gradient};
 use crate::lane_road_edges::{EdgeDistance, EdgeGeometry};
 use crate::lane_road_frames::{BoundOffset, FastFrame};
-use crate::params::PlannerParams;
-use crate::road_field::edge_term;
+use crate::road_field::{RoadFieldParams, edge_term};
 use crate::types::VehicleState;
 
 /// One divider prepared for Eq. 2: the lane whose bound it is, which bound, and where it holds.
@@ -408,7 +408,11 @@ pub struct LaneRoadField<'g> {
 impl<'g> LaneRoadField<'g> {
     /// The field with the planner's parameters (the same as `PotentialField`'s road field),
     /// without lane-end walls.
-    pub fn new(geometry: &'g LaneRoadGeometry, params: &PlannerParams, half_width_m: f64) -> Self {
+    pub fn new(
+        geometry: &'g LaneRoadGeometry,
+        params: &RoadFieldParams,
+        half_width_m: f64,
+    ) -> Self {
         Self {
             geometry,
             lane_amplitude: params.lane_amplitude,
@@ -421,15 +425,16 @@ impl<'g> LaneRoadField<'g> {
     }
 
     /// The field of a vehicle in `state`, with the lane-end rule's walls when
-    /// `params.lane_end_walls` ([`LaneRoadGeometry::lane_end_walls`] without a previous cycle:
+    /// `lane_end_walls` ([`LaneRoadGeometry::lane_end_walls`] without a previous cycle:
     /// walls only if the vehicle is settled now): [`wall_term`] along each, in d − d_div(s).
     pub fn for_vehicle(
         geometry: &'g LaneRoadGeometry,
-        params: &PlannerParams,
+        params: &RoadFieldParams,
+        lane_end_walls: bool,
         half_width_m: f64,
         state: &VehicleState,
     ) -> Self {
-        let walls = if params.lane_end_walls {
+        let walls = if lane_end_walls {
             geometry.lane_end_walls(state, half_width_m, None).0
         } else {
             Vec::new()
@@ -618,14 +623,14 @@ pub struct LaneAttraction<'a> {
 }
 
 impl<'a> LaneAttraction<'a> {
-    /// The target `params.target_lookahead_m` ahead of the point (x, y) (the ego) along the
-    /// target lane `lane`.
-    pub fn ahead_of(lane: &'a Lane, params: &PlannerParams, x_m: f64, y_m: f64) -> Self {
+    /// The target `params.lookahead_m` ahead of the point (x, y) (the ego) along the target
+    /// lane `lane`.
+    pub fn ahead_of(lane: &'a Lane, params: &AttractionParams, x_m: f64, y_m: f64) -> Self {
         let c = lane.centreline();
         Self {
             centreline: c,
-            gain_per_m2: params.attractive_gain_per_m2,
-            target_s_m: c.project([x_m, y_m]).s_m + params.target_lookahead_m,
+            gain_per_m2: params.gain_per_m2,
+            target_s_m: c.project([x_m, y_m]).s_m + params.lookahead_m,
         }
     }
 

@@ -10,6 +10,7 @@ pub mod attractive_field;
 pub mod behaviour;
 mod clarabel_setup;
 pub mod cubic_fit;
+pub mod derived_params;
 pub mod error;
 pub mod fallback;
 pub mod field_params;

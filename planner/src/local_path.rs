@@ -140,7 +140,14 @@ mod tests {
             yaw_rad: 0.0,
             speed_mps: 20.0,
         };
-        let field = PotentialField::new(&params, &road, 0, &ego, &VehicleShape::default(), &[]);
+        let field = PotentialField::new(
+            &(&params).into(),
+            &road,
+            0,
+            &ego,
+            &VehicleShape::default(),
+            &[],
+        );
         let path = local_path(&field, [0.0, 2.3], 5.0, 6, 10.0, 0.0);
         // Reference: Eq. 6–7 written out by hand from the force.
         let mut p = [0.0, 2.3];
@@ -179,7 +186,7 @@ mod tests {
         };
         let neighbours = [ahead];
         let field = PotentialField::new(
-            &params,
+            &(&params).into(),
             &road,
             0,
             &ego,
@@ -225,7 +232,14 @@ mod tests {
             yaw_rad: 0.0,
             speed_mps: 20.0,
         };
-        let field = PotentialField::new(&params, &road, 0, &ego, &VehicleShape::default(), &[]);
+        let field = PotentialField::new(
+            &(&params).into(),
+            &road,
+            0,
+            &ego,
+            &VehicleShape::default(),
+            &[],
+        );
         let path = local_path(&field, [0.0, 2.4], 5.0, 20, 1.0, 0.0);
         let centre = merge.lane_center_y_m(crate::road::Lane::Lower);
         let first_offset = (2.4 - centre).abs();

@@ -19,10 +19,10 @@
 
 use std::collections::BTreeMap;
 
+use crate::derived_params::PlanHorizon;
 use crate::lane_road_field::LaneRoadGeometry;
 use crate::obstacle_field::HeadingForm;
 use crate::obstacle_field::{ObstacleField, ObstacleFieldParams, Role, SelfView};
-use crate::params::PlannerParams;
 use crate::planners::PlanRequest;
 use crate::polyline::Polyline;
 use crate::prediction::{PredictionModel, Trajectory};
@@ -45,15 +45,16 @@ pub struct Other {
     pub ahead_now: bool,
 }
 
-/// The newest fresh SLP of each sender other than the ego.
+/// The newest fresh SLP of each sender other than the ego: one at most `max_age_s` old
+/// (`max_shared_path_age_s`).
 fn fresh_shared_paths<'a>(
-    params: &PlannerParams,
+    max_age_s: f64,
     req: &PlanRequest<'a>,
 ) -> BTreeMap<VehicleId, &'a SharedLocalPath> {
     let mut newest: BTreeMap<VehicleId, &SharedLocalPath> = BTreeMap::new();
     for m in req.shared_paths {
         let age_s = req.time_s - m.stamp_s;
-        if m.vehicle_id == req.ego_id || age_s > params.max_shared_path_age_s {
+        if m.vehicle_id == req.ego_id || age_s > max_age_s {
             continue;
         }
         match newest.get(&m.vehicle_id) {
@@ -66,17 +67,17 @@ fn fresh_shared_paths<'a>(
     newest
 }
 
-/// Whether any vehicle other than the ego has a fresh SLP in `req` (else PF-ISO has lost V2V,
-/// or nobody around is connected).
-pub fn has_fresh_shared_path(params: &PlannerParams, req: &PlanRequest<'_>) -> bool {
-    !fresh_shared_paths(params, req).is_empty()
+/// Whether any vehicle other than the ego has a fresh SLP in `req`, at most `max_age_s` old
+/// (`max_shared_path_age_s`; else PF-ISO has lost V2V, or nobody around is connected).
+pub fn has_fresh_shared_path(max_age_s: f64, req: &PlanRequest<'_>) -> bool {
+    !fresh_shared_paths(max_age_s, req).is_empty()
 }
 
-/// The others, by id: received SLPs if `use_shared_paths` (PF-ISO), then a prediction with
-/// `model` for every perceived neighbour without one. "Ahead" is measured along the frame of
-/// the ego's lane (larger s).
+/// The others, by id: received SLPs at most `max_age_s` old (`max_shared_path_age_s`) if
+/// `use_shared_paths` (PF-ISO), then a prediction with `model` for every perceived neighbour
+/// without one. "Ahead" is measured along the frame of the ego's lane (larger s).
 pub fn gather_others(
-    params: &PlannerParams,
+    max_age_s: f64,
     road: &LaneRoadGeometry,
     req: &PlanRequest<'_>,
     use_shared_paths: bool,
@@ -88,7 +89,7 @@ pub fn gather_others(
     let ego_s_m = road.s_m(ego_lane, ego_p);
     let ahead = |p: [f64; 2]| road.s_m(ego_lane, p) > ego_s_m;
     if use_shared_paths {
-        for (id, m) in fresh_shared_paths(params, req) {
+        for (id, m) in fresh_shared_paths(max_age_s, req) {
             let perceived = req.neighbours.iter().find(|n| n.id == id);
             let yaw = perceived.map_or(0.0, |n| n.state.yaw_rad);
             let p_now_m = perceived
@@ -152,9 +153,10 @@ fn role_of(rules: RoleRules, other: &Other) -> Role {
 }
 
 /// The field of `other` centred at the origin with heading 0 (moved per slot later), seen by
-/// the ego of `req`, with its role applied.
+/// the ego of `req`, with its role applied; `x_scale` is `field_params.x_scale()`.
 fn base_field(
     field_params: &ObstacleFieldParams,
+    x_scale: f64,
     rules: RoleRules,
     req: &PlanRequest<'_>,
     other: &Other,
@@ -173,7 +175,7 @@ fn base_field(
         &other.shape,
     );
     let contact_m = 0.5 * (req.ego_shape.length_m + other.shape.length_m);
-    field.with_role(role_of(rules, other), contact_m, field_params.x_scale())
+    field.with_role(role_of(rules, other), contact_m, x_scale)
 }
 
 /// `base` moved to a pose; for the correlation form of Eq. 4 its heading is taken relative to
@@ -192,15 +194,16 @@ fn moved_in_lane(
 }
 
 /// Absolute time of slot i (1-based): t_0 + i·Δt_plan.
-fn slot_time_s(params: &PlannerParams, req: &PlanRequest<'_>, i: usize) -> f64 {
-    req.time_s + i as f64 * params.step_time_s
+fn slot_time_s(horizon: &PlanHorizon, req: &PlanRequest<'_>, i: usize) -> f64 {
+    req.time_s + i as f64 * horizon.step_time_s
 }
 
 /// The arc-length term (module doc of `speed_optimisation::interaction_term`): the others'
-/// fields at their poses at each slot time, against the ego's position along `line`.
+/// fields at their poses at each of the `horizon`'s slot times, against the ego's position
+/// along `line`.
 #[allow(clippy::too_many_arguments)] // the term's inputs, each used once
 pub fn arc_length_term(
-    params: &PlannerParams,
+    horizon: &PlanHorizon,
     field_params: &ObstacleFieldParams,
     rules: RoleRules,
     aggregate: Aggregate,
@@ -209,14 +212,20 @@ pub fn arc_length_term(
     line: &Polyline,
     road: &LaneRoadGeometry,
 ) -> InteractionTerm {
-    let n = params.waypoint_count;
+    let n = horizon.waypoint_count;
+    let x_scale = field_params.x_scale();
     let bases: Vec<(ObstacleField, &Trajectory)> = others
         .iter()
-        .map(|o| (base_field(field_params, rules, req, o), &o.trajectory))
+        .map(|o| {
+            (
+                base_field(field_params, x_scale, rules, req, o),
+                &o.trajectory,
+            )
+        })
         .collect();
     let fields = (1..=n)
         .map(|i| {
-            let t_s = slot_time_s(params, req, i);
+            let t_s = slot_time_s(horizon, req, i);
             bases
                 .iter()
                 .map(|(base, trajectory)| {
@@ -230,32 +239,36 @@ pub fn arc_length_term(
     InteractionTerm::new(
         line.clone(),
         [cos_yaw, sin_yaw],
-        params.step_time_s,
+        horizon.step_time_s,
         aggregate,
         fields,
     )
 }
 
 /// The paper's reading of U_SLP (module doc of `speed_optimisation::fixed_waypoint_term`): the
-/// ego's Eq. 7 waypoint i against each other's pose and speed at slot i.
+/// ego's Eq. 7 waypoint i against each other's pose and speed at slot i, with the interaction
+/// term's fields (`field_params`) and floor ε_I (`floor`).
+#[allow(clippy::too_many_arguments)] // the term's inputs, each used once
 pub fn fixed_waypoint_term(
-    params: &PlannerParams,
+    horizon: &PlanHorizon,
+    field_params: &ObstacleFieldParams,
+    floor: f64,
     rules: RoleRules,
     req: &PlanRequest<'_>,
     others: &[Other],
     waypoints: &[[f64; 2]],
     road: &LaneRoadGeometry,
 ) -> FixedWaypointTerm {
-    let field_params = params.interaction_field();
+    let x_scale = field_params.x_scale();
     let bases: Vec<(ObstacleField, &Other)> = others
         .iter()
-        .map(|o| (base_field(&field_params, rules, req, o), o))
+        .map(|o| (base_field(field_params, x_scale, rules, req, o), o))
         .collect();
     let slots = waypoints
         .iter()
         .enumerate()
         .map(|(k, _)| {
-            let t_s = slot_time_s(params, req, k + 1);
+            let t_s = slot_time_s(horizon, req, k + 1);
             bases
                 .iter()
                 .map(|(base, other)| {
@@ -271,9 +284,9 @@ pub fn fixed_waypoint_term(
         })
         .collect();
     FixedWaypointTerm::new(
-        field_params,
+        *field_params,
         req.ego_shape,
-        params.interaction_floor,
+        floor,
         waypoints.to_vec(),
         slots,
     )

@@ -21,6 +21,7 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 
 use crate::cubic_fit::{FitMethod, fit_path_cubic};
+use crate::derived_params::DerivedParams;
 use crate::error::PlannerError;
 use crate::fallback::{FallbackInput, fallback_plan};
 use crate::following::{V2vLossFallback, following_cap_in_lane_frame_mps};
@@ -133,6 +134,8 @@ pub struct PlanStats {
 pub struct PfPlanner {
     kind: PlannerKind,
     params: PlannerParams,
+    /// Each part's settings, derived from `params` once, at construction (`derived_params`).
+    derived: DerivedParams,
     /// The road as lanes, prepared once (`lane_road_field.rs`), shareable between planners.
     road: Arc<LaneRoadGeometry>,
     last_good: Option<Plan>,
@@ -195,6 +198,7 @@ impl PfPlanner {
         params.validate()?;
         Ok(Self {
             kind,
+            derived: DerivedParams::new(&params),
             params,
             road,
             settled_lane: None,
@@ -267,7 +271,7 @@ impl PfPlanner {
     /// The lane-end rule's walls are those of the last cycle's settled lane.
     pub fn field<'s>(&'s self, req: &PlanRequest<'_>) -> PotentialField<'s> {
         let mut field = PotentialField::new(
-            &self.params,
+            &self.derived.field,
             &self.road,
             req.ego_id,
             &req.ego,
@@ -348,13 +352,20 @@ impl PfPlanner {
         waypoints: &[[f64; 2]],
     ) -> (Option<Box<dyn SpeedTerm>>, f64, usize) {
         let params = &self.params;
+        let derived = &self.derived;
         let (use_shared_paths, weight) = match kind {
             PlannerKind::PfCs | PlannerKind::PfSpEq10 => return (None, 0.0, 0),
             PlannerKind::PfSp => (false, params.risk_weight),
             PlannerKind::PfIso => (true, params.interaction_weight),
             PlannerKind::PfIsoPred => (false, params.interaction_weight),
         };
-        let others = gather_others(params, &self.road, req, use_shared_paths, params.prediction);
+        let others = gather_others(
+            params.max_shared_path_age_s,
+            &self.road,
+            req,
+            use_shared_paths,
+            params.prediction,
+        );
         let count = others.len();
         if others.is_empty() || weight <= 0.0 {
             return (None, weight, count);
@@ -366,8 +377,8 @@ impl PfPlanner {
                 from_order_now: params.roles_from_order_now,
             };
             Box::new(arc_length_term(
-                params,
-                &params.path_field(),
+                &derived.horizon,
+                &derived.field.obstacles,
                 rules,
                 Aggregate::Linear,
                 req,
@@ -382,8 +393,8 @@ impl PfPlanner {
             };
             match params.interaction_slp_reading {
                 SlpReading::ArcLength => Box::new(arc_length_term(
-                    params,
-                    &params.interaction_field(),
+                    &derived.horizon,
+                    &derived.interaction_field,
                     rules,
                     Aggregate::LogFloored {
                         floor: params.interaction_floor,
@@ -394,7 +405,14 @@ impl PfPlanner {
                     &self.road,
                 )),
                 SlpReading::FixedWaypoints => Box::new(fixed_waypoint_term(
-                    params, rules, req, &others, waypoints, &self.road,
+                    &derived.horizon,
+                    &derived.interaction_field,
+                    params.interaction_floor,
+                    rules,
+                    req,
+                    &others,
+                    waypoints,
+                    &self.road,
                 )),
             }
         };
@@ -411,7 +429,8 @@ impl PfPlanner {
         };
         self.settled_lane = settled_lane;
         let params = &self.params;
-        let n = params.waypoint_count;
+        let derived = &self.derived;
+        let n = derived.horizon.waypoint_count;
         let fail = |error: PlannerError, waypoints: Option<Vec<[f64; 2]>>| CycleFailure {
             error,
             waypoints,
@@ -419,7 +438,7 @@ impl PfPlanner {
 
         // Eqs. 1–7: waypoints by gradient steps.
         let mut field = PotentialField::new(
-            params,
+            &derived.field,
             &self.road,
             req.ego_id,
             &req.ego,
@@ -449,7 +468,7 @@ impl PfPlanner {
 
         // Eqs. 8–9: cubic in the vehicle frame.
         let (cubic, xis) = fit_path_cubic(
-            params,
+            &derived.cubic,
             [req.ego.x_m, req.ego.y_m],
             req.ego.yaw_rad,
             &waypoints,
@@ -464,7 +483,13 @@ impl PfPlanner {
         let segment_lengths_m = line.segment_lengths_m();
         // Stop and go (`stop_and_go` module): caps down to 0 behind a slow or stopped vehicle;
         // None in moving traffic, which is then planned exactly as without it.
-        let stop_caps_mps = stop_and_go_caps_mps(params, &self.road, req, &points, self.stopping);
+        let stop_caps_mps = stop_and_go_caps_mps(
+            &derived.stop_and_go,
+            &self.road,
+            req,
+            &points,
+            self.stopping,
+        );
         self.stopping = stop_caps_mps.is_some();
         self.stats.stop_and_go = self.stopping;
 
@@ -475,7 +500,7 @@ impl PfPlanner {
             && params.v2v_loss_fallback == V2vLossFallback::RiskAwareFollowing
             && heard_for_s > params.max_shared_path_age_s
             && req.neighbours.iter().any(|n| n.id != req.ego_id)
-            && !has_fresh_shared_path(params, req);
+            && !has_fresh_shared_path(params.max_shared_path_age_s, req);
         self.stats.v2v_degraded = degraded;
         let speed_kind = if degraded {
             PlannerKind::PfSp
@@ -511,7 +536,7 @@ impl PfPlanner {
                 if slows_only {
                     // The non-convex term may only slow the vehicle: cap at V_target, or at a
                     // comfortable deceleration from the current speed if that is higher.
-                    let decel_mps = params.max_accel_mps2 * params.step_time_s;
+                    let decel_mps = derived.horizon.max_speed_change_mps;
                     for (i, v) in max_speeds_mps.iter_mut().enumerate() {
                         let from_now = req.ego.speed_mps - decel_mps * (i + 1) as f64;
                         *v = v.min(req.target_speed_mps.max(from_now));
@@ -519,7 +544,7 @@ impl PfPlanner {
                 }
                 if degraded
                     && let Some(cap_mps) = following_cap_in_lane_frame_mps(
-                        params,
+                        &derived.following,
                         &self.road,
                         req.ego_id,
                         &req.ego,
@@ -529,7 +554,7 @@ impl PfPlanner {
                     )
                 {
                     // Reached no faster than at a_max from the current speed (feasible).
-                    let decel_mps = params.max_accel_mps2 * params.step_time_s;
+                    let decel_mps = derived.horizon.max_speed_change_mps;
                     for (i, v) in max_speeds_mps.iter_mut().enumerate() {
                         let from_now = req.ego.speed_mps - decel_mps * (i + 1) as f64;
                         *v = v.min(cap_mps.max(from_now).max(params.min_speed_mps));
@@ -546,7 +571,7 @@ impl PfPlanner {
                         .map(|i| {
                             speed_at_time(
                                 &last.path,
-                                req.time_s + (i as f64 - 0.5) * params.step_time_s,
+                                req.time_s + (i as f64 - 0.5) * derived.horizon.step_time_s,
                             )
                         })
                         .collect()
@@ -562,7 +587,7 @@ impl PfPlanner {
                 };
                 let solution = self
                     .optimiser
-                    .solve(params, &problem)
+                    .solve(&derived.speed, &problem)
                     .map_err(|e| fail(e, Some(waypoints.clone())))?;
                 self.stats.speed_solves = solution.solves;
                 self.stats.speed_stopped_at_iteration_cap = solution.stopped_at_iteration_cap;

@@ -7,13 +7,29 @@
 //! dividers and the drivable area's outer edges, and each obstacle's Eq. 4 heading is taken
 //! relative to its lane.
 
+use crate::attractive_field::AttractionParams;
 use crate::error::PlannerError;
 use crate::lane_road_field::{LaneRoadField, LaneRoadGeometry};
-use crate::obstacle_field::{ObstacleField, SelfView};
-use crate::params::PlannerParams;
+use crate::obstacle_field::{ObstacleField, ObstacleFieldParams, SelfView};
+use crate::road_field::RoadFieldParams;
 use crate::types::{Neighbour, VehicleId, VehicleShape, VehicleState};
 
 pub use mergesim_types::{GridSpec, MAX_GRID_CELLS};
+
+/// The numbers of the universal field U_uni = U_AT + U_LD + U_RE + Σ_j U_OB^j (Eq. 5), built
+/// once from `PlannerParams` (`derived_params`; `UniversalFieldParams::from(&params)`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UniversalFieldParams {
+    /// Eq. 1: λ and the moving target's look-ahead.
+    pub attraction: AttractionParams,
+    /// Eqs. 2–3: the lane dividers and the road edges.
+    pub road: RoadFieldParams,
+    /// The lane-end rule's walls (Eq. 3's term on the divider towards a lane that ends;
+    /// `lane_end_walls`).
+    pub lane_end_walls: bool,
+    /// Eq. 4 for the path: `PlannerParams::path_field`.
+    pub obstacles: ObstacleFieldParams,
+}
 
 /// The universal field seen by one planning vehicle at one planning instant.
 #[derive(Clone, Debug)]
@@ -37,7 +53,7 @@ pub struct PotentialField<'a> {
 impl<'a> PotentialField<'a> {
     /// The field of vehicle `ego_id` at `ego` among `neighbours` (its own entry is skipped).
     pub fn new(
-        params: &PlannerParams,
+        params: &UniversalFieldParams,
         road: &'a LaneRoadGeometry,
         ego_id: VehicleId,
         ego: &VehicleState,
@@ -56,12 +72,12 @@ impl<'a> PotentialField<'a> {
                 [n.state.speed_mps * c, n.state.speed_mps * s]
             })
             .collect();
-        let field_params = params.path_field();
+        let field_params = &params.obstacles;
         let obstacles = others
             .iter()
             .map(|n| {
                 ObstacleField::new(
-                    &field_params,
+                    field_params,
                     me,
                     n.state.x_m,
                     n.state.y_m,
@@ -75,11 +91,17 @@ impl<'a> PotentialField<'a> {
         let ego_p = [ego.x_m, ego.y_m];
         let target_lane = road.target_lane(road.lane_index_at(ego_p));
         Self {
-            attractive_gain_per_m2: params.attractive_gain_per_m2,
-            lookahead_m: params.target_lookahead_m,
+            attractive_gain_per_m2: params.attraction.gain_per_m2,
+            lookahead_m: params.attraction.lookahead_m,
             target_lane,
-            target_s_m: road.s_m(target_lane, ego_p) + params.target_lookahead_m,
-            road: LaneRoadField::for_vehicle(road, params, 0.5 * ego_shape.width_m, ego),
+            target_s_m: road.s_m(target_lane, ego_p) + params.attraction.lookahead_m,
+            road: LaneRoadField::for_vehicle(
+                road,
+                &params.road,
+                params.lane_end_walls,
+                0.5 * ego_shape.width_m,
+                ego,
+            ),
             obstacles,
             obstacle_velocities_mps,
         }
@@ -195,6 +217,7 @@ impl<'a> PotentialField<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::PlannerParams;
 
     fn state(x_m: f64, y_m: f64, yaw_rad: f64, speed_mps: f64) -> VehicleState {
         VehicleState {
@@ -207,7 +230,7 @@ mod tests {
 
     #[test]
     fn universal_gradient_matches_central_differences() {
-        let params = PlannerParams::default();
+        let params = UniversalFieldParams::from(&PlannerParams::default());
         let merge = crate::road::MergeRoad::default();
         let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let neighbours = [
@@ -260,7 +283,7 @@ mod tests {
     /// lane centre (found by bisection on F_y), and pushes back towards it on either side.
     #[test]
     fn default_lane_equilibria_sit_at_the_lane_centres() {
-        let params = PlannerParams::default();
+        let params = UniversalFieldParams::from(&PlannerParams::default());
         let merge = crate::road::MergeRoad::default();
         let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = state(0.0, 1.75, 0.0, 20.0);
@@ -280,7 +303,7 @@ mod tests {
 
     #[test]
     fn own_entry_among_neighbours_is_skipped() {
-        let params = PlannerParams::default();
+        let params = UniversalFieldParams::from(&PlannerParams::default());
         let merge = crate::road::MergeRoad::default();
         let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = state(0.0, 1.75, 0.0, 20.0);
@@ -302,7 +325,7 @@ mod tests {
 
     #[test]
     fn grid_samples_cell_centres_row_after_row() {
-        let params = PlannerParams::default();
+        let params = UniversalFieldParams::from(&PlannerParams::default());
         let merge = crate::road::MergeRoad::default();
         let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = state(0.0, 1.75, 0.0, 20.0);

@@ -15,6 +15,20 @@
 
 use crate::road::MergeRoad;
 
+/// The numbers of the road terms, Eqs. 2–3, shared by [`RoadField`] and the planners'
+/// `LaneRoadField`; built once from `PlannerParams` (`derived_params`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoadFieldParams {
+    /// A_lane, height of the lane-divider ridge of Eq. 2 (`lane_amplitude`).
+    pub lane_amplitude: f64,
+    /// σ of the lane-divider Gaussian of Eq. 2 (m; `lane_sigma_m`).
+    pub lane_sigma_m: f64,
+    /// ξ, scale of the edge field ½ ξ / g² of Eq. 3 (m²; `edge_gain_m2`).
+    pub edge_gain_m2: f64,
+    /// Clearance g_c below which Eq. 3's edge field is linear (m; `edge_clamp_distance_m`).
+    pub edge_clamp_distance_m: f64,
+}
+
 /// Road field of one vehicle (its half-width enters the edge clearance).
 #[derive(Clone, Copy, Debug)]
 pub struct RoadField<'a> {

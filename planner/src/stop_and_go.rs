@@ -58,10 +58,23 @@
 //! Outside such cycles (everybody around faster than `stop_and_go_speed_mps`) nothing here is
 //! computed, so moving traffic is planned bit for bit as before. 0 turns the cap off.
 
-use crate::following::{cap_behind, corridor_leaders_in_lane_frame};
+use crate::derived_params::PlanHorizon;
+use crate::following::{FollowingParams, cap_behind, corridor_leaders_in_lane_frame};
 use crate::lane_road_field::LaneRoadGeometry;
-use crate::params::PlannerParams;
 use crate::request::PlanRequest;
+
+/// The numbers of stop and go (module doc, item 2), built once from `PlannerParams`
+/// (`derived_params`). Not from the paper.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StopAndGoParams {
+    /// A cycle is a stop-and-go cycle when the vehicle or one ahead in its corridor is slower
+    /// than this (m/s; `stop_and_go_speed_mps`); 0 turns the cap off.
+    pub speed_threshold_mps: f64,
+    /// Gipps' safe-following speed and the corridor (`following` module).
+    pub following: FollowingParams,
+    /// The slots the caps are for (N of Eq. 7) and the speed change a_max·Δt_plan per slot.
+    pub horizon: PlanHorizon,
+}
 
 /// The per-slot caps of stop and go (module doc, item 2) for a cycle planning along `points`
 /// (the fitted path's points from the vehicle on), or `None` when the cycle is not a stop-and-go
@@ -69,13 +82,13 @@ use crate::request::PlanRequest;
 /// `stop_and_go_speed_mps` and, if the last cycle was one (`was_active`), Gipps' speed no
 /// longer below V_target; or the cap turned off.
 pub fn stop_and_go_caps_mps(
-    params: &PlannerParams,
+    params: &StopAndGoParams,
     road: &LaneRoadGeometry,
     req: &PlanRequest<'_>,
     points: &[[f64; 2]],
     was_active: bool,
 ) -> Option<Vec<f64>> {
-    let threshold_mps = params.stop_and_go_speed_mps;
+    let threshold_mps = params.speed_threshold_mps;
     if threshold_mps <= 0.0 {
         return None;
     }
@@ -90,7 +103,7 @@ pub fn stop_and_go_caps_mps(
         return None;
     }
     let leaders = corridor_leaders_in_lane_frame(
-        params,
+        &params.following,
         road,
         req.ego_id,
         &req.ego,
@@ -102,14 +115,14 @@ pub fn stop_and_go_caps_mps(
         || leaders
             .iter()
             .any(|&(_, speed_mps)| speed_mps < threshold_mps);
-    let cap_now_mps = cap_behind(params, &leaders)?;
+    let cap_now_mps = cap_behind(&params.following, &leaders)?;
     if !(slow || (was_active && cap_now_mps < req.target_speed_mps)) {
         return None;
     }
-    let decel_mps = params.max_accel_mps2 * params.step_time_s;
+    let decel_mps = params.horizon.max_speed_change_mps;
     let v0 = req.ego.speed_mps.max(0.0);
     Some(
-        (0..params.waypoint_count)
+        (0..params.horizon.waypoint_count)
             .map(|i| cap_now_mps.max(v0 - decel_mps * (i + 1) as f64).max(0.0))
             .collect(),
     )

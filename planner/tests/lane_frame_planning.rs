@@ -8,6 +8,7 @@ use mergesim_types::lanes::{
 };
 use planner::lane_road_field::LaneRoadGeometry;
 use planner::obstacle_field::HeadingForm;
+use planner::potential_field::UniversalFieldParams;
 use planner::*;
 
 fn state(x_m: f64, y_m: f64, yaw_rad: f64, speed_mps: f64) -> VehicleState {
@@ -74,7 +75,7 @@ fn universal_field_gradient_matches_finite_differences_on_the_curved_merge() {
                 neighbour(2, on_lane(&road, ending, 100.0, -0.2, -0.03, 22.0)),
             ];
             let field = PotentialField::new(
-                &params,
+                &UniversalFieldParams::from(&params),
                 &geometry,
                 0,
                 &ego,
@@ -158,9 +159,16 @@ fn a_rotated_copy_of_the_road_gives_the_same_field() {
             .iter()
             .map(|n| neighbour(n.id, rotate_state(n.state)))
             .collect();
-        let fa = PotentialField::new(&params, &ga, 0, &ego, &VehicleShape::default(), &others);
+        let fa = PotentialField::new(
+            &UniversalFieldParams::from(&params),
+            &ga,
+            0,
+            &ego,
+            &VehicleShape::default(),
+            &others,
+        );
         let fb = PotentialField::new(
-            &params,
+            &UniversalFieldParams::from(&params),
             &gb,
             0,
             &rotate_state(ego),

@@ -6,10 +6,10 @@ use mergesim_types::lanes::{
     ENDING_LANE_ID, LaneRoad, LaneRoadSpec, OnRampParams, THROUGH_LANE_ID, curved_merge_spec,
     on_ramp_ids, on_ramp_spec,
 };
-use planner::attractive_field::AttractiveField;
+use planner::attractive_field::{AttractionParams, AttractiveField};
 use planner::lane_frame::lane_relative_heading_rad;
 use planner::lane_road_field::{LaneAttraction, LaneRoadField, LaneRoadGeometry};
-use planner::road_field::RoadField;
+use planner::road_field::{RoadField, RoadFieldParams};
 use planner::{MergeRoad, PlannerParams, VehicleShape};
 
 fn half_width_m() -> f64 {
@@ -63,7 +63,7 @@ fn straight_road_gives_todays_field() {
     assert_eq!(geometry.divider_count(), 1);
     let p = PlannerParams::default();
     let old = today(&road, &p);
-    let new = LaneRoadField::new(&geometry, &p, half_width_m());
+    let new = LaneRoadField::new(&geometry, &RoadFieldParams::from(&p), half_width_m());
     let (mut n_equal, mut n_taper) = (0, 0);
     let (mut max_lane, mut max_edge, mut max_grad) = (0.0_f64, 0.0_f64, 0.0_f64);
     let (mut taper_value_rel, mut taper_grad_rel) = (0.0_f64, 0.0_f64);
@@ -168,7 +168,7 @@ fn straight_road_attraction_is_todays() {
         AttractiveField::moving_target_gradient(p.attractive_gain_per_m2, p.target_lookahead_m);
     for id in [THROUGH_LANE_ID, ENDING_LANE_ID] {
         let lane = lanes.lane(id).unwrap();
-        let new = LaneAttraction::ahead_of(lane, &p, ego_x, ego_y);
+        let new = LaneAttraction::ahead_of(lane, &AttractionParams::from(&p), ego_x, ego_y);
         for (x, y) in [
             (150.0, 1.75),
             (0.0, 5.25),
@@ -214,7 +214,7 @@ fn on_ramp(taper_length_m: f64) -> LaneRoad {
 fn check_gradients(road: &LaneRoad, n: usize, mut sample: impl FnMut(&mut Lcg) -> [f64; 2]) -> f64 {
     let geometry = LaneRoadGeometry::new(road);
     let p = PlannerParams::default();
-    let field = LaneRoadField::new(&geometry, &p, half_width_m());
+    let field = LaneRoadField::new(&geometry, &RoadFieldParams::from(&p), half_width_m());
     let mut rng = Lcg(21);
     let h = 1e-6;
     let mut worst = 0.0_f64;
@@ -235,7 +235,7 @@ fn check_gradients(road: &LaneRoad, n: usize, mut sample: impl FnMut(&mut Lcg) -
         }
         // The attraction along the through lane (lane 1 on both roads).
         let lane = road.lane(THROUGH_LANE_ID).unwrap();
-        let a = LaneAttraction::ahead_of(lane, &p, x - 30.0, y);
+        let a = LaneAttraction::ahead_of(lane, &AttractionParams::from(&p), x - 30.0, y);
         let ga = a.gradient(x, y);
         let fda = [
             (a.value(x + h, y) - a.value(x - h, y)) / (2.0 * h),
@@ -315,8 +315,8 @@ fn rotated_and_shifted_road_gives_the_same_field() {
     assert_eq!(ga.edge_count(), gb.edge_count());
     let p = PlannerParams::default();
     let (fa, fb) = (
-        LaneRoadField::new(&ga, &p, half_width_m()),
-        LaneRoadField::new(&gb, &p, half_width_m()),
+        LaneRoadField::new(&ga, &RoadFieldParams::from(&p), half_width_m()),
+        LaneRoadField::new(&gb, &RoadFieldParams::from(&p), half_width_m()),
     );
     let through = a.lane(THROUGH_LANE_ID).unwrap();
     let mut rng = Lcg(7);
@@ -337,8 +337,13 @@ fn rotated_and_shifted_road_gives_the_same_field() {
         let ego = [q[0] - 20.0, q[1]];
         let ego_m = rotate_shift(ego, angle, shift);
         let (la, lb) = (
-            LaneAttraction::ahead_of(through, &p, ego[0], ego[1]),
-            LaneAttraction::ahead_of(b.lane(THROUGH_LANE_ID).unwrap(), &p, ego_m[0], ego_m[1]),
+            LaneAttraction::ahead_of(through, &AttractionParams::from(&p), ego[0], ego[1]),
+            LaneAttraction::ahead_of(
+                b.lane(THROUGH_LANE_ID).unwrap(),
+                &AttractionParams::from(&p),
+                ego_m[0],
+                ego_m[1],
+            ),
         );
         assert!(close(la.value(q[0], q[1]), lb.value(qm[0], qm[1]), 1e-9));
         // Eq. 4's heading relative to the lane: the same for a vehicle turned with the map.
@@ -365,7 +370,7 @@ fn an_ending_lane_closes_with_an_edge() {
     assert!(end.closed);
     let geometry = LaneRoadGeometry::new(&road);
     let p = PlannerParams::default();
-    let field = LaneRoadField::new(&geometry, &p, half_width_m());
+    let field = LaneRoadField::new(&geometry, &RoadFieldParams::from(&p), half_width_m());
     let len = accel.length_m();
     // Eq. 3 measures the distance to the nearest point of each edge: the end is the nearest
     // part of the drivable area's edge within half a lane width (1.75 m) of it. There the field
@@ -399,7 +404,7 @@ fn an_ending_lane_closes_with_an_edge() {
     let road = MergeRoad::default();
     let lanes = road.lane_road().unwrap();
     let geometry = LaneRoadGeometry::new(&lanes);
-    let field = LaneRoadField::new(&geometry, &p, half_width_m());
+    let field = LaneRoadField::new(&geometry, &RoadFieldParams::from(&p), half_width_m());
     let ending = lanes.lane(ENDING_LANE_ID).unwrap();
     let mut last = 0.0;
     for s in [200.0, 240.0, 270.0, 290.0, 300.0] {
@@ -449,7 +454,7 @@ fn a_moving_divider_has_its_along_lane_gradient() {
     let geometry = LaneRoadGeometry::new(&road);
     assert_eq!(geometry.divider_count(), 1);
     let p = PlannerParams::default();
-    let field = LaneRoadField::new(&geometry, &p, half_width_m());
+    let field = LaneRoadField::new(&geometry, &RoadFieldParams::from(&p), half_width_m());
     // The ridge follows the divider: its along-lane gradient is the ∂U/∂s term.
     let lane = road.lane(LaneId(2)).unwrap();
     let s = 50.0;

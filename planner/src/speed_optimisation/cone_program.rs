@@ -25,11 +25,10 @@
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSolver, NonnegativeConeT, SecondOrderConeT, SupportedConeT};
 
-use super::SpeedProblem;
 use super::scp::SpeedOptimiser;
-use crate::clarabel_setup::{ProgramSettings, new_solver, solve_checked, solver_failed};
+use super::{SpeedBounds, SpeedOptimiserParams, SpeedProblem};
+use crate::clarabel_setup::{new_solver, solve_checked, solver_failed};
 use crate::error::PlannerError;
-use crate::params::PlannerParams;
 
 /// Offset of v_1 in the decision vector.
 pub const V_OFFSET: usize = 0;
@@ -48,11 +47,11 @@ pub(super) struct Layout {
 }
 
 impl Layout {
-    pub(super) fn new(params: &PlannerParams, n: usize) -> Self {
+    pub(super) fn new(bounds: &SpeedBounds, n: usize) -> Self {
         Self {
             n,
-            accel: params.accel_bound_enabled && n >= 2,
-            jerk: params.jerk_bound_enabled && n >= 3,
+            accel: bounds.accel_bound_enabled && n >= 2,
+            jerk: bounds.jerk_bound_enabled && n >= 3,
         }
     }
 
@@ -166,23 +165,13 @@ pub(super) struct CachedSolver {
 /// The name of both programs of the speed optimisation in errors.
 pub(super) const PROBLEM: &str = "speed_optimisation";
 
-/// Clarabel's settings for both programs of the speed optimisation: without equilibration and
-/// iterative refinement (`ProgramSettings::scaling_and_refinement`).
-pub(super) fn solver_settings(params: &PlannerParams) -> ProgramSettings {
-    ProgramSettings {
-        max_iterations: params.solver_max_iterations,
-        tolerance: params.solver_tolerance,
-        scaling_and_refinement: false,
-    }
-}
-
 impl SpeedOptimiser {
     /// One convex solve with the non-convex term linearised to `gradient` (already × its weight) and the
     /// box [lo, hi]. Returns v_1..v_N.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn solve_convex(
         &mut self,
-        params: &PlannerParams,
+        params: &SpeedOptimiserParams,
         layout: Layout,
         problem: &SpeedProblem<'_>,
         gradient: &[f64],
@@ -192,14 +181,15 @@ impl SpeedOptimiser {
         jerk_step: f64,
     ) -> Result<Vec<f64>, PlannerError> {
         let n = layout.n;
+        let w = &params.objective;
         // q = [w3 ∇φ − w2 V_target ; w1].
         let mut q = Vec::with_capacity(2 * n);
         q.extend(
             gradient
                 .iter()
-                .map(|g| g - params.speed_deviation_weight * problem.target_speed_mps),
+                .map(|g| g - w.speed_deviation_weight * problem.target_speed_mps),
         );
-        q.extend(std::iter::repeat_n(params.travel_time_weight, n));
+        q.extend(std::iter::repeat_n(w.travel_time_weight, n));
         // b, block by block.
         let mut b = Vec::with_capacity(layout.rows());
         b.extend_from_slice(hi);
@@ -215,12 +205,12 @@ impl SpeedOptimiser {
             });
         }
 
-        let w2_bits = params.speed_deviation_weight.to_bits();
-        let tolerance_bits = params.solver_tolerance.to_bits();
+        let w2_bits = w.speed_deviation_weight.to_bits();
+        let tolerance_bits = params.solver.tolerance.to_bits();
         let reusable = self.cached.as_ref().is_some_and(|c| {
             c.layout == layout
                 && c.w2_bits == w2_bits
-                && c.max_iterations == params.solver_max_iterations
+                && c.max_iterations == params.solver.max_iterations
                 && c.tolerance_bits == tolerance_bits
         });
         let updated = reusable
@@ -231,17 +221,17 @@ impl SpeedOptimiser {
         if !updated {
             let solver = new_solver(
                 PROBLEM,
-                &layout.p_matrix(params.speed_deviation_weight),
+                &layout.p_matrix(w.speed_deviation_weight),
                 &q,
                 &layout.a_matrix(),
                 &b,
                 &layout.cones(),
-                &solver_settings(params),
+                &params.solver,
             )?;
             self.cached = Some(CachedSolver {
                 layout,
                 w2_bits,
-                max_iterations: params.solver_max_iterations,
+                max_iterations: params.solver.max_iterations,
                 tolerance_bits,
                 solver,
             });

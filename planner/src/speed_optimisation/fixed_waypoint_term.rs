@@ -39,6 +39,8 @@ pub struct SlotOther {
 #[derive(Clone, Debug)]
 pub struct FixedWaypointTerm {
     field_params: ObstacleFieldParams,
+    /// √(−2 ln f) of `field_params` (σ_x = D_min / this), computed once.
+    x_scale: f64,
     ego_shape: VehicleShape,
     floor: f64,
     /// `waypoints[i]`: the ego's Eq. 7 waypoint of slot i + 1.
@@ -57,6 +59,7 @@ impl FixedWaypointTerm {
         others: Vec<Vec<SlotOther>>,
     ) -> Self {
         Self {
+            x_scale: field_params.x_scale(),
             field_params,
             ego_shape,
             floor,
@@ -68,7 +71,7 @@ impl FixedWaypointTerm {
     /// φ_i(v) and dφ_i/dv for one slot.
     fn slot(&self, i: usize, v_mps: f64) -> (f64, f64) {
         let p = self.waypoints[i];
-        let x_scale = self.field_params.x_scale();
+        let x_scale = self.x_scale;
         let me = SelfView {
             speed_mps: v_mps,
             shape: self.ego_shape,

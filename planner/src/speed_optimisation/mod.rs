@@ -82,7 +82,7 @@ pub use scp::SpeedOptimiser;
 
 use serde::{Deserialize, Serialize};
 
-use crate::params::PlannerParams;
+use crate::clarabel_setup::ProgramSettings;
 
 /// How each SCP iteration's convex subproblem is posed (`PlannerParams::speed_program`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -99,6 +99,67 @@ pub enum SpeedProgram {
     /// optimum at 2–3× less cost per planning cycle (docs/parameters.md).
     #[default]
     NewtonQp,
+}
+
+/// The weights of J's convex part (module doc), built once from `PlannerParams`
+/// (`derived_params`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpeedObjectiveParams {
+    /// w1, weight of the travel time Σ Δs_i / v_i (1/s; `travel_time_weight`).
+    pub travel_time_weight: f64,
+    /// w2, weight of the speed deviation Σ ½ (v_i − V_target)² (s²/m²;
+    /// `speed_deviation_weight`).
+    pub speed_deviation_weight: f64,
+}
+
+/// The constraints of Eq. 10 that do not come with the problem (module doc): the lower bound
+/// v_min and the optional acceleration and jerk rows, with their right-hand sides computed
+/// once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpeedBounds {
+    /// v_min ≤ v_i (m/s; `min_speed_mps`).
+    pub min_speed_mps: f64,
+    /// Whether |v_{i+1} − v_i| ≤ a_max Δt (and |v_1 − v_0| ≤ a_max Δt) is on
+    /// (`accel_bound_enabled`).
+    pub accel_bound_enabled: bool,
+    /// a_max Δt, the acceleration rows' bound (m/s; `max_accel_mps2` · `step_time_s`).
+    pub accel_step_mps: f64,
+    /// Whether |v_{i+1} − 2 v_i + v_{i−1}| ≤ j_max Δt² is on (`jerk_bound_enabled`).
+    pub jerk_bound_enabled: bool,
+    /// j_max Δt², the jerk rows' bound (m/s; `max_jerk_mps3` · `step_time_s`²).
+    pub jerk_step_mps: f64,
+}
+
+/// The SCP loop's settings (module doc, "Solution").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScpSettings {
+    /// ρ, the trust region's initial half-width on each speed (m/s; `trust_region_mps`).
+    pub trust_region_mps: f64,
+    /// Most convex solves (≥ 1; `max_scp_iterations`).
+    pub max_iterations: usize,
+    /// Stop when J falls by less than this fraction of |J| (`scp_relative_tolerance`).
+    pub relative_tolerance: f64,
+    /// Stop, stalled, when no descent step is found and ρ is below this (m/s;
+    /// `scp_stall_trust_region_mps`).
+    pub stall_trust_region_mps: f64,
+}
+
+/// Everything [`SpeedOptimiser::solve`] reads besides the [`SpeedProblem`], built once from
+/// `PlannerParams` (`derived_params`; `SpeedOptimiserParams::from(&params)`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpeedOptimiserParams {
+    /// w1 and w2 of J.
+    pub objective: SpeedObjectiveParams,
+    /// v_min and the acceleration and jerk rows.
+    pub bounds: SpeedBounds,
+    /// The SCP loop.
+    pub scp: ScpSettings,
+    /// How each convex subproblem is posed (`speed_program`).
+    pub program: SpeedProgram,
+    /// Clarabel's settings of both programs: `solver_max_iterations`, `solver_tolerance`,
+    /// without equilibration and iterative refinement
+    /// (`ProgramSettings::scaling_and_refinement`).
+    pub(crate) solver: ProgramSettings,
 }
 
 /// A smooth, possibly non-convex term Σ_i φ_i(v) of the speed objective, linearised by the SCP.
@@ -152,7 +213,11 @@ pub struct SpeedSolution {
 }
 
 /// J(v) of Eq. 10 (module doc), with the non-convex term if given.
-pub fn objective(params: &PlannerParams, problem: &SpeedProblem<'_>, speeds_mps: &[f64]) -> f64 {
+pub fn objective(
+    params: &SpeedObjectiveParams,
+    problem: &SpeedProblem<'_>,
+    speeds_mps: &[f64],
+) -> f64 {
     let mut j = 0.0;
     for (v, ds) in speeds_mps.iter().zip(problem.segment_lengths_m) {
         let dv = v - problem.target_speed_mps;
@@ -167,7 +232,12 @@ pub fn objective(params: &PlannerParams, problem: &SpeedProblem<'_>, speeds_mps:
 }
 
 /// ∂/∂v_i of the convex part of J (travel time and target speed): −w1 Δs_i / v_i² + w2 (v_i − V).
-fn smooth_gradient(params: &PlannerParams, problem: &SpeedProblem<'_>, i: usize, v: f64) -> f64 {
+fn smooth_gradient(
+    params: &SpeedObjectiveParams,
+    problem: &SpeedProblem<'_>,
+    i: usize,
+    v: f64,
+) -> f64 {
     -params.travel_time_weight * problem.segment_lengths_m[i] / (v * v)
         + params.speed_deviation_weight * (v - problem.target_speed_mps)
 }

@@ -28,12 +28,11 @@
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSolver, NonnegativeConeT, SupportedConeT};
 
-use super::SpeedProblem;
-use super::cone_program::{Layout, PROBLEM, solver_settings};
+use super::cone_program::{Layout, PROBLEM};
 use super::scp::SpeedOptimiser;
+use super::{SpeedOptimiserParams, SpeedProblem};
 use crate::clarabel_setup::{new_solver, solve_checked, solver_failed};
 use crate::error::PlannerError;
-use crate::params::PlannerParams;
 
 /// A Clarabel solver of the Newton QP and what fixes its structure.
 pub(super) struct CachedQp {
@@ -74,7 +73,7 @@ impl SpeedOptimiser {
     #[allow(clippy::too_many_arguments)]
     pub(super) fn solve_newton_qp(
         &mut self,
-        params: &PlannerParams,
+        params: &SpeedOptimiserParams,
         layout: Layout,
         problem: &SpeedProblem<'_>,
         at: &[f64],
@@ -85,8 +84,8 @@ impl SpeedOptimiser {
         jerk_step: f64,
     ) -> Result<Vec<f64>, PlannerError> {
         let n = layout.n;
-        let w1 = params.travel_time_weight;
-        let w2 = params.speed_deviation_weight;
+        let w1 = params.objective.travel_time_weight;
+        let w2 = params.objective.speed_deviation_weight;
         let mut h = Vec::with_capacity(n);
         let mut q = Vec::with_capacity(n);
         for i in 0..n {
@@ -105,10 +104,10 @@ impl SpeedOptimiser {
             });
         }
 
-        let tolerance_bits = params.solver_tolerance.to_bits();
+        let tolerance_bits = params.solver.tolerance.to_bits();
         let reusable = self.cached_qp.as_ref().is_some_and(|c| {
             c.layout == layout
-                && c.max_iterations == params.solver_max_iterations
+                && c.max_iterations == params.solver.max_iterations
                 && c.tolerance_bits == tolerance_bits
         });
         let updated = reusable
@@ -125,11 +124,11 @@ impl SpeedOptimiser {
                 &layout.qp_a_matrix(),
                 &b,
                 &layout.qp_cones(),
-                &solver_settings(params),
+                &params.solver,
             )?;
             self.cached_qp = Some(CachedQp {
                 layout,
-                max_iterations: params.solver_max_iterations,
+                max_iterations: params.solver.max_iterations,
                 tolerance_bits,
                 solver,
             });
@@ -149,6 +148,7 @@ impl SpeedOptimiser {
 mod tests {
     use super::super::{SpeedProblem, SpeedProgram};
     use super::*;
+    use crate::params::PlannerParams;
 
     fn params(program: SpeedProgram, scp_iterations: usize) -> PlannerParams {
         PlannerParams {
@@ -193,11 +193,11 @@ mod tests {
         let (segment_lengths_m, max_speeds_mps) = bends();
         let problem = convex(&segment_lengths_m, &max_speeds_mps, 15.0, 18.0);
         let exact = SpeedOptimiser::new()
-            .solve(&params(SpeedProgram::Cone, 2), &problem)
+            .solve(&(&params(SpeedProgram::Cone, 2)).into(), &problem)
             .unwrap();
         assert_eq!(exact.solves, 1);
         let newton = SpeedOptimiser::new()
-            .solve(&params(SpeedProgram::NewtonQp, 30), &problem)
+            .solve(&(&params(SpeedProgram::NewtonQp, 30)).into(), &problem)
             .unwrap();
         assert!(newton.solves > 1, "the QP iterates on a convex problem");
         for (a, b) in newton.speeds_mps.iter().zip(&exact.speeds_mps) {
@@ -211,7 +211,7 @@ mod tests {
         let (segment_lengths_m, max_speeds_mps) = bends();
         let problem = convex(&segment_lengths_m, &max_speeds_mps, 10.0, 25.0);
         let p = params(SpeedProgram::NewtonQp, 2);
-        let solution = SpeedOptimiser::new().solve(&p, &problem).unwrap();
+        let solution = SpeedOptimiser::new().solve(&(&p).into(), &problem).unwrap();
         let step = p.max_accel_mps2 * p.step_time_s;
         assert!(solution.anchored);
         assert!((solution.speeds_mps[0] - 10.0).abs() <= step + 1e-6);
@@ -231,8 +231,8 @@ mod tests {
     fn a_non_positive_expansion_point_is_a_typed_error_not_a_division_by_zero() {
         let (segment_lengths_m, max_speeds_mps) = bends();
         let problem = convex(&segment_lengths_m, &max_speeds_mps, 15.0, 18.0);
-        let p = params(SpeedProgram::NewtonQp, 2);
-        let layout = Layout::new(&p, 20);
+        let p = SpeedOptimiserParams::from(&params(SpeedProgram::NewtonQp, 2));
+        let layout = Layout::new(&p.bounds, 20);
         let mut at = vec![15.0; 20];
         at[3] = 0.0;
         let err = SpeedOptimiser::new()

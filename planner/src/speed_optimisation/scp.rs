@@ -4,9 +4,10 @@
 
 use super::cone_program::{CachedSolver, Layout};
 use super::newton_qp::CachedQp;
-use super::{SpeedProblem, SpeedProgram, SpeedSolution, objective, smooth_gradient};
+use super::{
+    SpeedOptimiserParams, SpeedProblem, SpeedProgram, SpeedSolution, objective, smooth_gradient,
+};
 use crate::error::PlannerError;
-use crate::params::PlannerParams;
 
 /// The speed optimiser. Holds a Clarabel solver between solves (and planning cycles) so only
 /// q and b are rewritten; it is rebuilt when the problem's structure changes.
@@ -94,7 +95,7 @@ impl SpeedOptimiser {
     /// iterations that fail just end the iteration with the last accepted speeds.
     pub fn solve(
         &mut self,
-        params: &PlannerParams,
+        params: &SpeedOptimiserParams,
         problem: &SpeedProblem<'_>,
     ) -> Result<SpeedSolution, PlannerError> {
         let n = problem.segment_lengths_m.len();
@@ -125,16 +126,17 @@ impl SpeedOptimiser {
                 what: "speed problem data".into(),
             });
         }
-        let layout = Layout::new(params, n);
-        let accel_step = params.max_accel_mps2 * params.step_time_s;
-        let jerk_step = params.max_jerk_mps3 * params.step_time_s * params.step_time_s;
+        let layout = Layout::new(&params.bounds, n);
+        let accel_step = params.bounds.accel_step_mps;
+        let jerk_step = params.bounds.jerk_step_mps;
+        let weights = &params.objective;
 
         // Box bounds: v_min ≤ v_i ≤ max(V_i^max, v_min).
-        let lo = vec![params.min_speed_mps; n];
+        let lo = vec![params.bounds.min_speed_mps; n];
         let hi: Vec<f64> = problem
             .max_speeds_mps
             .iter()
-            .map(|v| v.max(params.min_speed_mps))
+            .map(|v| v.max(params.bounds.min_speed_mps))
             .collect();
         // Anchor v_1 to the current speed when the chain stays feasible.
         let mut lo_anchor = lo.clone();
@@ -166,7 +168,7 @@ impl SpeedOptimiser {
         };
 
         // Without interaction the problem is convex: one exact solve of the cone program.
-        if interaction.is_none() && params.speed_program == SpeedProgram::Cone {
+        if interaction.is_none() && params.program == SpeedProgram::Cone {
             let zero = vec![0.0; n];
             let mut solves = 1;
             let v = match self.solve_convex(
@@ -183,7 +185,7 @@ impl SpeedOptimiser {
                 }
                 Err(e) => return Err(e),
             };
-            let j = objective(params, problem, &v);
+            let j = objective(weights, problem, &v);
             if !j.is_finite() {
                 return Err(PlannerError::NonFinite {
                     what: "speed objective".into(),
@@ -211,14 +213,14 @@ impl SpeedOptimiser {
             f64::INFINITY
         };
         let mut v = project_onto_chain(&raw_guess, &base_lo, &base_hi, chain_step);
-        let mut j = objective(params, problem, &v);
+        let mut j = objective(weights, problem, &v);
         let mut trust_first = !layout.jerk && j.is_finite();
-        let mut rho = params.trust_region_mps;
+        let mut rho = params.scp.trust_region_mps;
         let mut solves = 0;
         let mut solved_once = false;
         // Cleared by every way out of the loop but running out of iterations.
         let mut stopped_at_iteration_cap = true;
-        for iteration in 0..params.max_scp_iterations {
+        for iteration in 0..params.scp.max_iterations {
             let g = gradient_at(&v);
             let (lo_k, hi_k): (Vec<f64>, Vec<f64>) = if iteration > 0 || trust_first {
                 (
@@ -237,7 +239,7 @@ impl SpeedOptimiser {
                 (base_lo.clone(), base_hi.clone())
             };
             solves += 1;
-            let solved = match params.speed_program {
+            let solved = match params.program {
                 SpeedProgram::Cone => self.solve_convex(
                     params, layout, problem, &g, &lo_k, &hi_k, accel_step, jerk_step,
                 ),
@@ -254,7 +256,7 @@ impl SpeedOptimiser {
                 }
             };
             solved_once = true;
-            let jc = objective(params, problem, &candidate);
+            let jc = objective(weights, problem, &candidate);
             if !trust_first && iteration == 0 {
                 // No feasible start to compare with: take the first solution as it is.
                 v = candidate;
@@ -265,14 +267,14 @@ impl SpeedOptimiser {
             // Backtracking (Armijo) line search along d = candidate − v̄ on the true J.
             let d: Vec<f64> = candidate.iter().zip(&v).map(|(c, vi)| c - vi).collect();
             let slope: f64 = (0..n)
-                .map(|i| (smooth_gradient(params, problem, i, v[i]) + g[i]) * d[i])
+                .map(|i| (smooth_gradient(weights, problem, i, v[i]) + g[i]) * d[i])
                 .sum();
             let mut step = 1.0;
             let mut accepted = None;
             if slope.is_finite() && slope < 0.0 {
                 for _ in 0..=LINE_SEARCH_HALVINGS {
                     let trial: Vec<f64> = v.iter().zip(&d).map(|(vi, di)| vi + step * di).collect();
-                    let jt = objective(params, problem, &trial);
+                    let jt = objective(weights, problem, &trial);
                     if jt.is_finite() && jt < j && jt <= j + ARMIJO_FRACTION * step * slope {
                         accepted = Some((trial, jt));
                         break;
@@ -283,7 +285,7 @@ impl SpeedOptimiser {
             if step < 1.0 || accepted.is_none() {
                 rho *= 0.5;
             }
-            if accepted.is_none() && rho < params.scp_stall_trust_region_mps {
+            if accepted.is_none() && rho < params.scp.stall_trust_region_mps {
                 // No descent step and a trust region this small: stalled, not capped.
                 stopped_at_iteration_cap = false;
                 break;
@@ -292,7 +294,7 @@ impl SpeedOptimiser {
                 let decrease = j - jt;
                 v = trial;
                 j = jt;
-                if decrease <= params.scp_relative_tolerance * j.abs().max(1.0) {
+                if decrease <= params.scp.relative_tolerance * j.abs().max(1.0) {
                     stopped_at_iteration_cap = false;
                     break;
                 }
@@ -317,6 +319,7 @@ impl SpeedOptimiser {
 mod tests {
     use super::super::SpeedProblem;
     use super::*;
+    use crate::params::PlannerParams;
 
     fn unbounded_params() -> PlannerParams {
         PlannerParams {
@@ -371,7 +374,7 @@ mod tests {
             interaction_weight: 0.0,
         };
         let mut optimiser = SpeedOptimiser::new();
-        let solution = optimiser.solve(&params, &problem).unwrap();
+        let solution = optimiser.solve(&(&params).into(), &problem).unwrap();
         if program == SpeedProgram::Cone {
             assert_eq!(solution.solves, 1);
         }
@@ -396,7 +399,7 @@ mod tests {
             "travel time pushes above V_target"
         );
         // The cached solver gives the same answer on a re-solve.
-        let again = optimiser.solve(&params, &problem).unwrap();
+        let again = optimiser.solve(&(&params).into(), &problem).unwrap();
         for (a, b) in again.speeds_mps.iter().zip(&solution.speeds_mps) {
             assert!((a - b).abs() < 1e-9, "{a} vs {b}");
         }
@@ -425,7 +428,9 @@ mod tests {
                 speed_deviation_weight: 0.8,
                 ..unbounded_params()
             };
-            SpeedOptimiser::new().solve(&params, &problem).unwrap()
+            SpeedOptimiser::new()
+                .solve(&(&params).into(), &problem)
+                .unwrap()
         };
         let one = solve(SpeedProgram::NewtonQp, 1);
         assert_eq!(one.solves, 1);
@@ -453,7 +458,9 @@ mod tests {
             interaction: None,
             interaction_weight: 0.0,
         };
-        let solution = SpeedOptimiser::new().solve(&params, &problem).unwrap();
+        let solution = SpeedOptimiser::new()
+            .solve(&(&params).into(), &problem)
+            .unwrap();
         assert!(solution.anchored);
         let step = params.max_accel_mps2 * params.step_time_s;
         assert!((solution.speeds_mps[0] - (10.0 + step)).abs() < 1e-5);
@@ -484,7 +491,9 @@ mod tests {
             interaction: None,
             interaction_weight: 0.0,
         };
-        let solution = SpeedOptimiser::new().solve(&params, &problem).unwrap();
+        let solution = SpeedOptimiser::new()
+            .solve(&(&params).into(), &problem)
+            .unwrap();
         let dt = params.step_time_s;
         let jerk_step = params.max_jerk_mps3 * dt * dt;
         let accel_step = params.max_accel_mps2 * dt;
@@ -501,7 +510,7 @@ mod tests {
         assert!(v[8..].iter().all(|x| *x <= 12.0 + 1e-6), "{v:?}");
         // The bound binds: without it the profile has a sharper corner.
         let free = SpeedOptimiser::new()
-            .solve(&PlannerParams::default(), &problem)
+            .solve(&(&PlannerParams::default()).into(), &problem)
             .unwrap();
         let max_second_difference = free
             .speeds_mps
@@ -526,7 +535,9 @@ mod tests {
             interaction: None,
             interaction_weight: 0.0,
         };
-        let solution = SpeedOptimiser::new().solve(&params, &problem).unwrap();
+        let solution = SpeedOptimiser::new()
+            .solve(&(&params).into(), &problem)
+            .unwrap();
         assert!(!solution.anchored);
         assert!(solution.speeds_mps[1] <= 8.0 + 1e-6);
     }
@@ -548,7 +559,9 @@ mod tests {
             interaction: None,
             interaction_weight: 0.0,
         };
-        let err = SpeedOptimiser::new().solve(&params, &problem).unwrap_err();
+        let err = SpeedOptimiser::new()
+            .solve(&(&params).into(), &problem)
+            .unwrap_err();
         assert!(matches!(err, PlannerError::SolverFailed { .. }), "{err}");
     }
 }

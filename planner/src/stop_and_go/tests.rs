@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::parameter_set::ParameterSet;
+use crate::params::PlannerParams;
 use crate::planners::{PfPlanner, PlannerKind};
 use crate::road::{Lane, MergeRoad};
 use crate::types::{Neighbour, SharedLocalPath, TimedWaypoint, VehicleShape, VehicleState};
@@ -118,7 +119,7 @@ fn at_standstill_behind_a_stopped_car_every_planner_plans_finite_speeds_down_to_
             let ahead = [leader(at(200.0 + length_m + s0 + 0.3, 0.0))];
             let plan = plan_once(&mut planner(kind, &params), 0.0, ego, &ahead, &[]);
             assert_finite_and_non_negative(&plan, &what);
-            let cap = crate::following::safe_following_speed_mps(&params, s0 + 0.3, 0.0);
+            let cap = crate::following::safe_following_speed_mps(&(&params).into(), s0 + 0.3, 0.0);
             assert!(cap < params.min_speed_mps, "{cap}");
             assert!(
                 plan.path.iter().all(|p| p.speed_mps <= cap + 1e-12),
@@ -164,7 +165,7 @@ fn moving_traffic_has_no_stop_and_go_caps() {
             neighbours,
             shared_paths: &[],
         };
-        stop_and_go_caps_mps(&params, &road, &req, &points, false)
+        stop_and_go_caps_mps(&(&params).into(), &road, &req, &points, false)
     };
     let fast = [leader(at(240.0, 10.0))];
     assert_eq!(request(12.0, &fast), None);
@@ -189,16 +190,19 @@ fn moving_traffic_has_no_stop_and_go_caps() {
         neighbours: &slow,
         shared_paths: &[],
     };
-    assert_eq!(stop_and_go_caps_mps(&off, &road, &req, &points, true), None);
+    assert_eq!(
+        stop_and_go_caps_mps(&(&off).into(), &road, &req, &points, true),
+        None
+    );
     // Once on, it stays on while the car ahead holds it below V_target (12 m/s), ...
     let close = [leader(at(215.0, 10.0))];
     let req = PlanRequest {
         neighbours: &close,
         ..req
     };
-    assert!(stop_and_go_caps_mps(&params, &road, &req, &points, true).is_some());
+    assert!(stop_and_go_caps_mps(&(&params).into(), &road, &req, &points, true).is_some());
     assert_eq!(
-        stop_and_go_caps_mps(&params, &road, &req, &points, false),
+        stop_and_go_caps_mps(&(&params).into(), &road, &req, &points, false),
         None
     );
     // ... and ends when it no longer does.
@@ -208,7 +212,7 @@ fn moving_traffic_has_no_stop_and_go_caps() {
         ..req
     };
     assert_eq!(
-        stop_and_go_caps_mps(&params, &road, &req, &points, true),
+        stop_and_go_caps_mps(&(&params).into(), &road, &req, &points, true),
         None
     );
 }

@@ -158,7 +158,14 @@ pub fn lateral_equilibrium_m(params: &PlannerParams, neighbour: Option<(f64, f64
         .into_iter()
         .collect();
     let geometry = planner::lane_road_field::LaneRoadGeometry::new(&road.lane_road().unwrap());
-    let field = planner::PotentialField::new(params, &geometry, 0, &ego, &shape, &neighbours);
+    let field = planner::PotentialField::new(
+        &planner::potential_field::UniversalFieldParams::from(params),
+        &geometry,
+        0,
+        &ego,
+        &shape,
+        &neighbours,
+    );
     let fy = |y: f64| field.stepping_force(100.0, y)[1];
     let (mut lo, mut hi) = (centre - 1.0, centre + 1.0);
     assert!(fy(lo) > 0.0 && fy(hi) < 0.0, "restoring on both sides");
