@@ -7,16 +7,16 @@
 //! speak these types, and depend on nothing else to do so.
 #![warn(missing_docs)]
 
-pub mod behaviour;
+pub(crate) mod behaviour;
 pub mod bounds;
-pub mod error;
+pub(crate) mod error;
 pub mod files;
-pub mod grid;
+pub(crate) mod grid;
 pub mod lanes;
-pub mod path;
+pub(crate) mod path;
 pub mod percentile;
 pub mod road;
-pub mod vehicle;
+pub(crate) mod vehicle;
 
 pub use behaviour::{
     Behaviour, BehaviourError, Decision, DegradedMode, Observation, OptimiserReport,
