@@ -53,7 +53,7 @@ pub enum V2vLossFallback {
 
 /// Gipps' safe speed behind a leader at bumper gap `gap_m` driving at `leader_speed_mps`
 /// (module doc); 0 when even a standing start is too close.
-pub fn safe_following_speed_mps(params: &PlannerParams, gap_m: f64, leader_speed_mps: f64) -> f64 {
+pub(crate) fn safe_following_speed_mps(params: &PlannerParams, gap_m: f64, leader_speed_mps: f64) -> f64 {
     let b = params.max_accel_mps2;
     let tau = params.following_reaction_s;
     let room_m = gap_m - params.following_standstill_gap_m;
@@ -103,7 +103,7 @@ fn meeting_x_m(ego: &VehicleState, ego_shape: &VehicleShape, n: &Neighbour) -> f
 
 /// The vehicles ahead of `ego` (shape `ego_shape`) in its corridor along `path` (world points
 /// from its position on; module doc), each as (bumper gap along X (m), speed (m/s)).
-pub fn corridor_leaders(
+pub(crate) fn corridor_leaders(
     params: &PlannerParams,
     ego_id: VehicleId,
     ego: &VehicleState,
@@ -145,7 +145,7 @@ pub fn following_cap_mps(
 }
 
 /// The smallest safe-following speed behind `leaders` ((gap, speed) pairs); `None` if empty.
-pub fn cap_behind(params: &PlannerParams, leaders: &[(f64, f64)]) -> Option<f64> {
+pub(crate) fn cap_behind(params: &PlannerParams, leaders: &[(f64, f64)]) -> Option<f64> {
     leaders
         .iter()
         .map(|&(gap_m, speed_mps)| safe_following_speed_mps(params, gap_m, speed_mps))
@@ -156,7 +156,7 @@ pub fn cap_behind(params: &PlannerParams, leaders: &[(f64, f64)]) -> Option<f64>
 /// mapped into the frame of the ego's lane (x → s along it, y → d across it), so "ahead", the
 /// bumper gap and the corridor are measured along the road, curved or not (on a straight road
 /// along +x the same figures as in world coordinates).
-pub fn corridor_leaders_in_lane_frame(
+pub(crate) fn corridor_leaders_in_lane_frame(
     params: &PlannerParams,
     road: &LaneRoadGeometry,
     ego_id: VehicleId,
@@ -187,7 +187,7 @@ pub fn corridor_leaders_in_lane_frame(
 }
 
 /// [`following_cap_mps`] on a road of lanes ([`corridor_leaders_in_lane_frame`]).
-pub fn following_cap_in_lane_frame_mps(
+pub(crate) fn following_cap_in_lane_frame_mps(
     params: &PlannerParams,
     road: &LaneRoadGeometry,
     ego_id: VehicleId,

@@ -7,35 +7,35 @@
 #![warn(missing_docs)]
 
 pub mod attractive_field;
-pub mod behaviour;
+pub(crate) mod behaviour;
 mod clarabel_setup;
 pub mod cubic_fit;
-pub mod error;
+pub(crate) mod error;
 pub mod fallback;
-pub mod field_params;
+pub(crate) mod field_params;
 pub mod following;
 pub mod lane_frame;
 mod lane_road_edges;
 pub mod lane_road_field;
 mod lane_road_frames;
 pub mod local_path;
-pub mod min_distance;
+pub(crate) mod min_distance;
 pub mod obstacle_field;
 pub mod others;
-pub mod parameter_set;
+pub(crate) mod parameter_set;
 pub mod params;
 pub mod params_tables;
-pub mod planners;
+pub(crate) mod planners;
 pub mod polyline;
-pub mod potential_field;
-pub mod prediction;
-pub mod request;
-pub mod road;
+pub(crate) mod potential_field;
+pub(crate) mod prediction;
+pub(crate) mod request;
+pub(crate) mod road;
 pub mod road_field;
 pub mod speed_optimisation;
 pub mod speed_profile;
-pub mod stop_and_go;
-pub mod types;
+pub(crate) mod stop_and_go;
+pub(crate) mod types;
 
 pub use error::PlannerError;
 pub use following::V2vLossFallback;

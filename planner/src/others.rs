@@ -1,7 +1,7 @@
 //! What a planning vehicle knows about the others for its speed choice (Eq. 10 and PF-SP), and
 //! the non-convex speed terms built from it.
 //!
-//! Each other vehicle comes with a [`Trajectory`]: its received shared local path (PF-ISO, if
+//! Each other vehicle comes with a `Trajectory`: its received shared local path (PF-ISO, if
 //! fresh) or a prediction from its perceived state (`PlannerParams::prediction`; PF-ISO-PRED and
 //! PF-SP always, PF-ISO for a vehicle without a fresh SLP), and whether it is ahead of the
 //! planning vehicle *now* (larger s along the ego's lane).
@@ -68,14 +68,14 @@ fn fresh_shared_paths<'a>(
 
 /// Whether any vehicle other than the ego has a fresh SLP in `req` (else PF-ISO has lost V2V,
 /// or nobody around is connected).
-pub fn has_fresh_shared_path(params: &PlannerParams, req: &PlanRequest<'_>) -> bool {
+pub(crate) fn has_fresh_shared_path(params: &PlannerParams, req: &PlanRequest<'_>) -> bool {
     !fresh_shared_paths(params, req).is_empty()
 }
 
 /// The others, by id: received SLPs if `use_shared_paths` (PF-ISO), then a prediction with
 /// `model` for every perceived neighbour without one. "Ahead" is measured along the frame of
 /// the ego's lane (larger s).
-pub fn gather_others(
+pub(crate) fn gather_others(
     params: &PlannerParams,
     road: &LaneRoadGeometry,
     req: &PlanRequest<'_>,
@@ -129,7 +129,7 @@ pub fn gather_others(
 
 /// How the roles shape one other vehicle's field (module doc).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RoleRules {
+pub(crate) struct RoleRules {
     /// Per-slot roles for received SLPs: the front shrunk to the contact distance.
     pub rear_only: bool,
     /// Fixed roles from the order now for predicted vehicles.
@@ -199,7 +199,7 @@ fn slot_time_s(params: &PlannerParams, req: &PlanRequest<'_>, i: usize) -> f64 {
 /// The arc-length term (module doc of `speed_optimisation::interaction_term`): the others'
 /// fields at their poses at each slot time, against the ego's position along `line`.
 #[allow(clippy::too_many_arguments)] // the term's inputs, each used once
-pub fn arc_length_term(
+pub(crate) fn arc_length_term(
     params: &PlannerParams,
     field_params: &ObstacleFieldParams,
     rules: RoleRules,
@@ -238,7 +238,7 @@ pub fn arc_length_term(
 
 /// The paper's reading of U_SLP (module doc of `speed_optimisation::fixed_waypoint_term`): the
 /// ego's Eq. 7 waypoint i against each other's pose and speed at slot i.
-pub fn fixed_waypoint_term(
+pub(crate) fn fixed_waypoint_term(
     params: &PlannerParams,
     rules: RoleRules,
     req: &PlanRequest<'_>,
