@@ -15,20 +15,20 @@
 #![warn(missing_docs)]
 
 pub mod collision_groups;
-pub mod controls;
-pub mod error;
-pub mod kinematic_body;
-pub mod kinematics;
+pub(crate) mod controls;
+pub(crate) mod error;
+pub(crate) mod kinematic_body;
+pub(crate) mod kinematics;
 pub mod maneuver;
-pub mod params;
-pub mod physics_world;
-pub mod presets;
+pub(crate) mod params;
+pub(crate) mod physics_world;
+pub(crate) mod presets;
 pub mod road_collider;
-pub mod single_track;
-pub mod tire;
+pub(crate) mod single_track;
+pub(crate) mod tire;
 pub mod tracker;
-pub mod vehicle;
-pub mod wheel;
+pub(crate) mod vehicle;
+pub(crate) mod wheel;
 
 pub use controls::{Controls, WHEEL_NAMES};
 pub use error::VehicleError;
