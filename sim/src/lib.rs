@@ -3,36 +3,36 @@
 //! recording), the simulator's own drivers and the registry of planners by name.
 #![warn(missing_docs)]
 
-pub mod agent;
-pub mod body_state;
+pub(crate) mod agent;
+pub(crate) mod body_state;
 pub mod config;
 pub mod drivers;
-pub mod error;
-pub mod event;
+pub(crate) mod error;
+pub(crate) mod event;
 pub mod goal;
 pub mod idm;
-pub mod lane_membership;
+pub(crate) mod lane_membership;
 pub mod metrics;
-pub mod observer;
-pub mod outcome;
+pub(crate) mod observer;
+pub(crate) mod outcome;
 pub mod paper_metrics;
-pub mod planner_params;
-pub mod planner_stats;
+pub(crate) mod planner_params;
+pub(crate) mod planner_stats;
 pub mod profile;
-pub mod recorded_motion;
+pub(crate) mod recorded_motion;
 pub mod recorded_traffic;
 pub mod recording;
-pub mod recording_observer;
+pub(crate) mod recording_observer;
 pub mod registry;
 pub mod rng;
 pub mod road_config;
 pub mod road_drawing;
 pub mod route;
-pub mod run_log;
+pub(crate) mod run_log;
 pub mod safety;
 pub mod spatial;
 pub mod v2v;
-pub mod world;
+pub(crate) mod world;
 
 pub use config::{Driver, SimConfig, VehicleSpec, validate_vehicles};
 pub use error::SimError;

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 /// A phase of the tick.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Phase {
+pub(crate) enum Phase {
     /// V2V delivery.
     V2v,
     /// Building observations, the behaviours' decisions, their events, and broadcasting.
@@ -29,7 +29,7 @@ pub enum Phase {
 
 impl Phase {
     /// Every phase, in tick order.
-    pub const ALL: [Phase; 8] = [
+    pub(crate) const ALL: [Phase; 8] = [
         Phase::V2v,
         Phase::Planning,
         Phase::Tracking,
@@ -41,7 +41,7 @@ impl Phase {
     ];
 
     /// Its name in reports.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Phase::V2v => "v2v",
             Phase::Planning => "planning",
@@ -57,14 +57,14 @@ impl Phase {
 
 /// Accumulates wall time per phase when enabled; every call is a no-op otherwise.
 #[derive(Clone, Debug, Default)]
-pub struct Profiler {
+pub(crate) struct Profiler {
     enabled: bool,
     totals: [Duration; Phase::ALL.len()],
 }
 
 impl Profiler {
     /// A profiler that measures (`enabled`) or does nothing.
-    pub fn new(enabled: bool) -> Self {
+    pub(crate) fn new(enabled: bool) -> Self {
         Self {
             enabled,
             totals: Default::default(),
@@ -72,7 +72,7 @@ impl Profiler {
     }
 
     /// Now, if measuring.
-    pub fn start(&self) -> Option<Instant> {
+    pub(crate) fn start(&self) -> Option<Instant> {
         self.enabled.then(Instant::now)
     }
 
@@ -84,14 +84,14 @@ impl Profiler {
     }
 
     /// Adds `elapsed` to `phase`.
-    pub fn add(&mut self, phase: Phase, elapsed: Duration) {
+    pub(crate) fn add(&mut self, phase: Phase, elapsed: Duration) {
         if self.enabled {
             self.totals[phase as usize] += elapsed;
         }
     }
 
     /// The report (None when not measuring).
-    pub fn report(&self) -> Option<ProfileReport> {
+    pub(crate) fn report(&self) -> Option<ProfileReport> {
         self.enabled.then(|| ProfileReport {
             phases: Phase::ALL
                 .iter()
