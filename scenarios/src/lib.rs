@@ -8,11 +8,11 @@
 #![warn(missing_docs)]
 
 pub mod builtin;
-pub mod commonroad;
+pub(crate) mod commonroad;
 mod commonroad_toml;
-pub mod distribution;
+pub(crate) mod distribution;
 mod opendrive_source;
-pub mod oriented_box;
+pub(crate) mod oriented_box;
 pub mod platoon;
 pub mod randomisation;
 pub mod scenario;
