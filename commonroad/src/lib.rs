@@ -18,8 +18,8 @@
 //! Everything stays in the file's coordinates; the road of lanes shifts far maps to a local
 //! origin internally.
 
-pub mod error;
-pub mod limits;
+pub(crate) mod error;
+pub(crate) mod limits;
 pub mod model;
 mod read;
 mod read_lanelets;
