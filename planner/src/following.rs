@@ -53,7 +53,11 @@ pub enum V2vLossFallback {
 
 /// Gipps' safe speed behind a leader at bumper gap `gap_m` driving at `leader_speed_mps`
 /// (module doc); 0 when even a standing start is too close.
-pub(crate) fn safe_following_speed_mps(params: &PlannerParams, gap_m: f64, leader_speed_mps: f64) -> f64 {
+pub(crate) fn safe_following_speed_mps(
+    params: &PlannerParams,
+    gap_m: f64,
+    leader_speed_mps: f64,
+) -> f64 {
     let b = params.max_accel_mps2;
     let tau = params.following_reaction_s;
     let room_m = gap_m - params.following_standstill_gap_m;

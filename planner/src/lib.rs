@@ -4,6 +4,21 @@
 //! No physics engine, no logging backend: plain state in, plan out, so it can run on a car.
 //! `planner/README.md` maps each equation of the paper to the function implementing it and
 //! lists every reading of a typo or unit problem.
+//!
+//! # Public API
+//! - The planner: [`PfPlanner`] (a [`Behaviour`](mergesim_types::Behaviour)) of a [`PlannerKind`], built
+//!   from [`PlannerParams`] (or a named [`ParameterSet`]); one planning step takes a
+//!   [`PlanRequest`] and gives a [`Plan`] (or a [`PlannerError`]), with [`PlanStats`] and, when it
+//!   fell back, a [`FallbackReason`].
+//! - Its parameters: [`PlannerParams`], [`SlpReading`], [`SpeedProgram`], [`V2vLossFallback`] and
+//!   the tables of a scenario's `[planner.*]` keys, [`params_tables`].
+//! - The fields and steps, usable on their own: [`PotentialField`] on a
+//!   [`GridSpec`](mergesim_types::GridSpec),
+//!   [`attractive_field`], [`obstacle_field`], [`road_field`], [`lane_road_field`],
+//!   [`lane_frame`], [`local_path`], [`cubic_fit`], [`speed_optimisation`], [`SpeedProfile`],
+//!   [`fallback`], [`following`] and [`others`].
+//! - The plain data it speaks (vehicle state and shape, path points, shared local paths, the
+//!   merge road) is [`mergesim_types`]'.
 #![warn(missing_docs)]
 
 pub mod attractive_field;
@@ -39,11 +54,10 @@ pub(crate) mod types;
 
 pub use error::PlannerError;
 pub use following::V2vLossFallback;
-pub use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
 pub use parameter_set::ParameterSet;
 pub use params::{PlannerParams, SlpReading};
 pub use planners::{PfPlanner, PlanRequest, PlanStats, PlannerKind};
-pub use potential_field::{GridSpec, PotentialField};
+pub use potential_field::PotentialField;
 pub use road::{Lane, MergeRoad};
 pub use speed_optimisation::SpeedProgram;
 pub use speed_profile::SpeedProfile;

@@ -54,7 +54,11 @@ impl Polyline {
     /// Point and unit tangent at arc length `s_m`. Before the start and past the end the
     /// polyline continues straight along its first / last non-degenerate segment; a polyline
     /// of one point (or of coincident points) has tangent `fallback_tangent`.
-    pub(crate) fn point_and_tangent(&self, s_m: f64, fallback_tangent: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+    pub(crate) fn point_and_tangent(
+        &self,
+        s_m: f64,
+        fallback_tangent: [f64; 2],
+    ) -> ([f64; 2], [f64; 2]) {
         let n = self.points.len();
         // Index k of the segment [k, k+1] holding s (clamped to the first / last).
         let k = self

@@ -13,7 +13,7 @@ use crate::obstacle_field::{ObstacleField, SelfView};
 use crate::params::PlannerParams;
 use crate::types::{Neighbour, VehicleId, VehicleShape, VehicleState};
 
-pub use mergesim_types::GridSpec;
+pub(crate) use mergesim_types::GridSpec;
 
 /// The universal field seen by one planning vehicle at one planning instant.
 #[derive(Clone, Debug)]

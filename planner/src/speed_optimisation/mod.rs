@@ -152,7 +152,11 @@ pub(crate) struct SpeedSolution {
 }
 
 /// J(v) of Eq. 10 (module doc), with the non-convex term if given.
-pub(crate) fn objective(params: &PlannerParams, problem: &SpeedProblem<'_>, speeds_mps: &[f64]) -> f64 {
+pub(crate) fn objective(
+    params: &PlannerParams,
+    problem: &SpeedProblem<'_>,
+    speeds_mps: &[f64],
+) -> f64 {
     let mut j = 0.0;
     for (v, ds) in speeds_mps.iter().zip(problem.segment_lengths_m) {
         let dv = v - problem.target_speed_mps;
