@@ -61,7 +61,12 @@ pub(crate) fn lane_change(lanes: &LaneRoad, from: LaneId, to: LaneId) -> Option<
 
 /// Signed distance of `p_m` to the bound of lane `from` facing lane `to` (m, in `from`'s frame;
 /// negative inside `from`): 0 on the divider crossed by a change `from` → `to`.
-pub(crate) fn beyond_divider_m(lanes: &LaneRoad, from: LaneId, to: LaneId, p_m: [f64; 2]) -> Option<f64> {
+pub(crate) fn beyond_divider_m(
+    lanes: &LaneRoad,
+    from: LaneId,
+    to: LaneId,
+    p_m: [f64; 2],
+) -> Option<f64> {
     let lane = lanes.lane(from)?;
     let fp = lane.project(p_m);
     if lane.left_neighbour() == Some(to) {

@@ -107,7 +107,11 @@ impl Recorder {
     }
 
     /// No-op.
-    pub(crate) fn log_event(&mut self, _text: &str, _level: EventLevel) -> Result<(), RecordingError> {
+    pub(crate) fn log_event(
+        &mut self,
+        _text: &str,
+        _level: EventLevel,
+    ) -> Result<(), RecordingError> {
         Ok(())
     }
 }
