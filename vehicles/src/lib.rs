@@ -12,6 +12,18 @@
 //! vehicle.apply_forces(&mut world, mu);   // every vehicle, in id order
 //! world.step();
 //! ```
+//!
+//! # Public API
+//! - The physics scene: [`PhysicsWorld`] (gravity [`GRAVITY_MPS2`]) with the road's walls,
+//!   [`RoadColliders`] from [`RoadColliderParams`] ([`road_collider`], [`collision_groups`]).
+//! - A car: [`Vehicle`] from [`VehicleParams`] and [`TireParams`] (the presets
+//!   [`PRESET_NAMES`]), driven by [`Controls`] ([`WHEEL_NAMES`]), read back as [`Kinematics`],
+//!   [`BodyBox`] and [`WheelTelemetry`]; a body moved kinematically, [`KinematicBox`].
+//! - The path tracker: [`Tracker`] from [`TrackerParams`], with its [`SpeedController`].
+//! - Validation: [`run_maneuver`] of a [`ManeuverConfig`] ([`ManeuverKind`]) gives a
+//!   [`ManeuverReport`], compared with the linear single-track model [`LinearSingleTrack`]
+//!   ([`linear_yaw_rate_radps`]).
+//! - Errors: [`VehicleError`].
 #![warn(missing_docs)]
 
 pub mod collision_groups;

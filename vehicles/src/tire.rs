@@ -151,7 +151,13 @@ impl TireCurves {
 
     /// Combined-slip forces at normal load `fz_n`, clipped to the friction circle μ·Fz.
     #[inline]
-    pub(crate) fn combined(&self, p: &TireParams, fz_n: f64, kappa: f64, alpha_rad: f64) -> TireForces {
+    pub(crate) fn combined(
+        &self,
+        p: &TireParams,
+        fz_n: f64,
+        kappa: f64,
+        alpha_rad: f64,
+    ) -> TireForces {
         if fz_n <= 0.0 {
             return TireForces::default();
         }

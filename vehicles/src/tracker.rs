@@ -255,7 +255,12 @@ impl SpeedController {
     }
 
     /// Drive / brake torques tracking `target_mps` (wheel order FL, FR, RL, RR).
-    pub(crate) fn update(&mut self, target_mps: f64, speed_mps: f64, dt_s: f64) -> ([f64; 4], [f64; 4]) {
+    pub(crate) fn update(
+        &mut self,
+        target_mps: f64,
+        speed_mps: f64,
+        dt_s: f64,
+    ) -> ([f64; 4], [f64; 4]) {
         self.update_with_feedforward(target_mps, 0.0, speed_mps, dt_s)
     }
 
