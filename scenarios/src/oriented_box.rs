@@ -18,7 +18,13 @@ pub(crate) struct OrientedBox {
 
 impl OrientedBox {
     /// The body centred at (s, d) of `lane`, along the lane's heading at s.
-    pub(crate) fn on_lane(lane: &Lane, s_m: f64, d_m: f64, half_length_m: f64, half_width_m: f64) -> Self {
+    pub(crate) fn on_lane(
+        lane: &Lane,
+        s_m: f64,
+        d_m: f64,
+        half_length_m: f64,
+        half_width_m: f64,
+    ) -> Self {
         let (sin, cos) = lane.heading_rad(s_m).sin_cos();
         Self {
             centre_m: lane.point(s_m, d_m),
