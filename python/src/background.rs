@@ -31,7 +31,11 @@ pub(crate) fn fresh_pool(threads: Option<usize>) -> PyResult<Arc<rayon::ThreadPo
 /// Runs `work(interrupt)` on a pool of `threads` created for it, without the GIL; a signal
 /// handler that raises (Ctrl-C: `KeyboardInterrupt`) sets `interrupt`, and its exception is
 /// returned once the work has stopped.
-pub(crate) fn run_interruptible<T, F>(py: Python<'_>, threads: Option<usize>, work: F) -> PyResult<T>
+pub(crate) fn run_interruptible<T, F>(
+    py: Python<'_>,
+    threads: Option<usize>,
+    work: F,
+) -> PyResult<T>
 where
     T: Send,
     F: FnOnce(Arc<AtomicBool>) -> T + Send,
