@@ -5,6 +5,19 @@
 //! the benchmarks: [`planner`] (pure potential-field planning with interactive speed
 //! optimisation), [`vehicles`] (Rapier vehicles and tracker), [`sim`] (the closed loop) and
 //! [`scenarios`] (scenario files).
+//!
+//! # Public API
+//! - The command line: [`cli::main`] and [`cli::main_with`] (a registry with the user's own
+//!   planners).
+//! - One run: [`experiment::run_instance`] and [`experiment::run_quietly`] (with
+//!   [`experiment::InstanceOptions`]) give an [`experiment::Finished`] run; its JSON summary is
+//!   [`summary`], its text report [`report`], its figures [`plots`] and its animation
+//!   [`animation`].
+//! - Many runs: Monte-Carlo sweeps ([`sweep`], [`sweep::SweepPlan`], [`sweep::instance_seed`]),
+//!   pre-registered studies ([`study`]), the scaling curve ([`scaling`]) and the paired tests
+//!   they report ([`inference`]).
+//! - Files and provenance: [`output`] (files written whole or not at all), [`exact_seed`]
+//!   (seeds kept exact in JSON and CSV) and [`build_info`].
 #![warn(missing_docs)]
 
 pub mod animation;
