@@ -106,7 +106,7 @@ impl Visitor<'_> for SeedVisitor {
 }
 
 /// The same for `Option<u64>` (`null` for none).
-pub mod option {
+pub(crate) mod option {
     use serde::{Deserialize, Deserializer, Serializer};
 
     /// Writes `Some(seed)` as [`format_seed`](super::format_seed) does, `None` as `null`.

@@ -5,6 +5,19 @@
 //! the benchmarks: [`planner`] (pure potential-field planning with interactive speed
 //! optimisation), [`vehicles`] (Rapier vehicles and tracker), [`sim`] (the closed loop) and
 //! [`scenarios`] (scenario files).
+//!
+//! # Public API
+//! - The command line: [`cli::main`] and [`cli::main_with`] (a registry with the user's own
+//!   planners).
+//! - One run: [`experiment::run_instance`] and [`experiment::run_quietly`] (with
+//!   [`experiment::InstanceOptions`]) give an [`experiment::Finished`] run; its JSON summary is
+//!   [`summary`], its text report [`report`], its figures [`plots`] and its animation
+//!   [`animation`].
+//! - Many runs: Monte-Carlo sweeps ([`sweep`], [`sweep::SweepPlan`], [`sweep::instance_seed`]),
+//!   pre-registered studies ([`study`]), the scaling curve ([`scaling`]) and the paired tests
+//!   they report ([`inference`]).
+//! - Files and provenance: [`output`] (files written whole or not at all), [`exact_seed`]
+//!   (seeds kept exact in JSON and CSV) and [`build_info`].
 #![warn(missing_docs)]
 
 pub mod animation;
@@ -12,14 +25,14 @@ pub mod build_info;
 pub mod cli;
 pub mod exact_seed;
 pub mod experiment;
-pub mod grid;
-pub mod grid_plot;
+pub(crate) mod grid;
+pub(crate) mod grid_plot;
 pub mod inference;
-pub mod limits;
+pub(crate) mod limits;
 pub mod output;
 pub mod plots;
 pub mod report;
-pub mod run_caption;
+pub(crate) mod run_caption;
 pub mod scaling;
 pub mod study;
 pub mod summary;

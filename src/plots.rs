@@ -8,7 +8,7 @@
 //! system font library (fontconfig, freetype) is needed to build or run.
 //!
 //! Every figure opens with a caption band naming the scenario, the parameter set and the
-//! simulator's commit ([`crate::run_caption::RunCaption`]); every panel's legend sits right of
+//! simulator's commit (`crate::run_caption::RunCaption`); every panel's legend sits right of
 //! its chart, outside the plotting area, so it covers no data.
 //!
 //! Every file is written whole or not at all ([`crate::output::write_atomically`]).
@@ -32,7 +32,7 @@ mod legend;
 mod motion_states;
 mod paths;
 
-pub use legend::PixelBox;
+pub(crate) use legend::PixelBox;
 pub(crate) use legend::{CAPTION_PX, draw_caption};
 use legend::{LegendEntry, draw_legend};
 use motion_states::draw_states;

@@ -3,30 +3,30 @@
 //! thresholds, collision handling), run paired on the same instances, resumable and shardable
 //! like a sweep, and reported with the statistics a referee expects.
 //!
-//! - [`plan`]: the plan format ([`PLAN_FORMAT`]), checked before any run;
-//! - [`endpoints`]: the figures a plan may name and their units;
+//! - [`plan`]: the plan format (`PLAN_FORMAT`), checked before any run;
+//! - `endpoints`: the figures a plan may name and their units;
 //! - [`runner`]: the runs and their rows (JSONL), shards and resumption;
-//! - [`analysis`]: paired differences, t-interval, t-test, Wilcoxon, Holm, McNemar, Newcombe
+//! - `analysis`: paired differences, t-interval, t-test, Wilcoxon, Holm, McNemar, Newcombe
 //!   (computed by [`crate::inference`]);
-//! - [`report`], [`figure`], [`provenance`]: the report folder and what it cites.
+//! - `report`, `figure`, [`provenance`]: the report folder and what it cites.
 
-pub mod analysis;
-pub mod endpoints;
-pub mod figure;
+pub(crate) mod analysis;
+pub(crate) mod endpoints;
+pub(crate) mod figure;
 pub mod plan;
 pub mod provenance;
-pub mod report;
+pub(crate) mod report;
 pub mod runner;
 
 use std::path::Path;
 
 pub use analysis::{Analysis, analyse};
 pub use plan::{MAX_STUDY_RUNS, PlanError, StudyPlan};
-pub use report::StudyReport;
+pub(crate) use report::StudyReport;
 pub use runner::{RunOptions, StudyError, StudyRow, run_study};
 
 /// The plan format, as `merge_sim study --help` prints it.
-pub const PLAN_FORMAT: &str = include_str!("study/plan_format.txt");
+pub(crate) const PLAN_FORMAT: &str = include_str!("study/plan_format.txt");
 
 /// Runs the whole plan (no shard, no resumption, no rows file) and returns its report: what
 /// the Python binding calls. The report folder is written if `out` is given.

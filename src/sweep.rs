@@ -25,11 +25,11 @@ mod engine;
 mod figures;
 mod merge;
 mod paired;
-pub mod parquet;
-pub mod resume;
+pub(crate) mod parquet;
+pub(crate) mod resume;
 mod rows;
-pub mod shard;
-pub mod statistics;
+pub(crate) mod shard;
+pub(crate) mod statistics;
 mod summary;
 
 use std::sync::Arc;

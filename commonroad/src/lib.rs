@@ -17,9 +17,18 @@
 //!
 //! Everything stays in the file's coordinates; the road of lanes shifts far maps to a local
 //! origin internally.
+//!
+//! # Public API
+//! - Reading: [`read_file`], [`read_str`], and [`read_with_road`] (the scenario and its road of
+//!   lanes in one call); errors are [`CommonRoadError`] of an [`ErrorKind`]; input limits
+//!   [`MAX_FILE_BYTES`], [`MAX_LANELETS`], [`MAX_OBSTACLES`], [`MAX_STATES_PER_OBSTACLE`].
+//! - The data read: [`model`] ([`model::Scenario`] with its [`model::Lanelet`]s,
+//!   [`model::Obstacle`]s and [`model::PlanningProblem`]s).
+//! - The road of lanes of a lanelet network: [`road::lane_road_spec`] (with
+//!   [`road::commonroad_tolerances`]).
 
-pub mod error;
-pub mod limits;
+pub(crate) mod error;
+pub(crate) mod limits;
 pub mod model;
 mod read;
 mod read_lanelets;

@@ -24,6 +24,11 @@
 //!
 //! What is not taken: elevation and banking (the road is planar), lane layers other than the
 //! permanent one, objects, signals and road marks.
+//!
+//! # Public API
+//! - [`read_file`] and [`read_str`] give an [`OpenDriveRoad`]: the road of lanes and, per lane,
+//!   its [`LaneOrigin`] in the file; errors are [`OpenDriveError`].
+//! - Input limits: [`MAX_FILE_BYTES`], [`MAX_LANES`], [`MAX_COORDINATE_M`].
 
 mod error;
 mod road;

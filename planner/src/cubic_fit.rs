@@ -64,7 +64,7 @@ pub struct CubicFitParams {
 
 /// Box bounds on the coefficients (Eq. 9a).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CoefficientBounds {
+pub(crate) struct CoefficientBounds {
     /// a_min.
     pub lower: [f64; 4],
     /// a_max.
@@ -119,7 +119,7 @@ fn normal_equations(x: &[f64], y: &[f64], w: &[f64]) -> (Matrix4<f64>, Vector4<f
 /// Decision vector a = [a0..a3]; P = M (upper triangle), q = −r;
 /// rows 0..4: a ≤ upper (A = I, b = upper); rows 4..8: −a ≤ −lower (A = −I, b = −lower),
 /// all in the nonnegative cone.
-pub fn solve_box_qp(
+pub(crate) fn solve_box_qp(
     m: &Matrix4<f64>,
     r: &Vector4<f64>,
     bounds: &CoefficientBounds,
@@ -173,7 +173,7 @@ pub fn solve_box_qp(
 }
 
 /// Weighted least-squares cubic through (x_k, y_k) with weights w_k, within `bounds` (Eq. 9).
-pub fn fit_bounded_cubic(
+pub(crate) fn fit_bounded_cubic(
     x: &[f64],
     y: &[f64],
     w: &[f64],
@@ -228,21 +228,21 @@ impl CubicPath {
     }
 
     /// η = f(ξ / S) (m).
-    pub fn lateral_m(&self, xi_m: f64) -> f64 {
+    pub(crate) fn lateral_m(&self, xi_m: f64) -> f64 {
         let [a0, a1, a2, a3] = self.coefficients;
         let u = xi_m / self.x_scale_m;
         a0 + u * (a1 + u * (a2 + u * a3))
     }
 
     /// dη/dξ.
-    pub fn slope(&self, xi_m: f64) -> f64 {
+    pub(crate) fn slope(&self, xi_m: f64) -> f64 {
         let [_, a1, a2, a3] = self.coefficients;
         let u = xi_m / self.x_scale_m;
         (a1 + u * (2.0 * a2 + 3.0 * u * a3)) / self.x_scale_m
     }
 
     /// d²η/dξ² (1/m).
-    pub fn second_derivative_per_m(&self, xi_m: f64) -> f64 {
+    pub(crate) fn second_derivative_per_m(&self, xi_m: f64) -> f64 {
         let [_, _, a2, a3] = self.coefficients;
         let u = xi_m / self.x_scale_m;
         (2.0 * a2 + 6.0 * a3 * u) / (self.x_scale_m * self.x_scale_m)
@@ -250,14 +250,14 @@ impl CubicPath {
 
     /// Signed curvature κ = η'' / (1 + η'²)^{3/2} of the cubic at ξ (1/m). The paper's
     /// κ = 6 a3 s + 2 a2 ≈ 2 a2 is the small-slope, unscaled form of the same quantity.
-    pub fn curvature_per_m(&self, xi_m: f64) -> f64 {
+    pub(crate) fn curvature_per_m(&self, xi_m: f64) -> f64 {
         let d1 = self.slope(xi_m);
         let d2 = self.second_derivative_per_m(xi_m);
         d2 / (1.0 + d1 * d1).powf(1.5)
     }
 
     /// World point of the cubic at ξ.
-    pub fn world_point(&self, xi_m: f64) -> [f64; 2] {
+    pub(crate) fn world_point(&self, xi_m: f64) -> [f64; 2] {
         let eta = self.lateral_m(xi_m);
         [
             self.origin_xy_m[0] + self.cos_yaw * xi_m - self.sin_yaw * eta,

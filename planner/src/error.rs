@@ -2,7 +2,7 @@
 
 use thiserror::Error;
 
-pub use mergesim_types::InvalidParameter;
+pub(crate) use mergesim_types::InvalidParameter;
 
 /// Everything that can go wrong in the planner. Never a panic.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -41,7 +41,7 @@ pub enum PlannerError {
 
 impl PlannerError {
     /// Shorthand for [`PlannerError::InvalidParameter`].
-    pub fn invalid(name: impl Into<String>, value: f64, reason: impl Into<String>) -> Self {
+    pub(crate) fn invalid(name: impl Into<String>, value: f64, reason: impl Into<String>) -> Self {
         Self::InvalidParameter(InvalidParameter::new(name, value, reason))
     }
 

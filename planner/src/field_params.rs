@@ -32,7 +32,7 @@ pub enum MinDistanceLength {
 
 impl MinDistanceLength {
     /// (l + l_o)/2 for the chosen length (m).
-    pub fn half_sum_m(self, me: &VehicleShape, other: &VehicleShape) -> f64 {
+    pub(crate) fn half_sum_m(self, me: &VehicleShape, other: &VehicleShape) -> f64 {
         match self {
             MinDistanceLength::Wheelbase => 0.5 * (me.wheelbase_m + other.wheelbase_m),
             MinDistanceLength::BodyLength => 0.5 * (me.length_m + other.length_m),
@@ -69,12 +69,12 @@ pub struct ObstacleFieldParams {
 
 impl ObstacleFieldParams {
     /// √(−2 ln f): σ_x = D_min / this.
-    pub fn x_scale(&self) -> f64 {
+    pub(crate) fn x_scale(&self) -> f64 {
         (-2.0 * self.fraction_at_min_distance.ln()).sqrt()
     }
 
     /// σ_y (m).
-    pub fn sigma_lateral_m(&self) -> f64 {
+    pub(crate) fn sigma_lateral_m(&self) -> f64 {
         self.lateral_safety_m / (-2.0 * (self.epsilon / self.amplitude).ln()).sqrt()
     }
 }

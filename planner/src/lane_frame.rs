@@ -26,7 +26,7 @@ pub struct FrameJacobian {
 
 /// ∇s and ∇d from the frame's axes (the inverse Jacobian's rows). A degenerate frame
 /// (∂p/∂s ∥ ∂p/∂d: only at |d| ≥ the radius of curvature) gives zeros.
-pub fn frame_gradients(axes: &FrameAxes) -> ([f64; 2], [f64; 2]) {
+pub(crate) fn frame_gradients(axes: &FrameAxes) -> ([f64; 2], [f64; 2]) {
     let (ps, pd) = (axes.dp_ds, axes.dp_dd);
     let det = ps[0] * pd[1] - ps[1] * pd[0];
     if det.abs() <= f64::EPSILON || !det.is_finite() {
@@ -48,7 +48,7 @@ pub fn frame_jacobian(centreline: &Centreline, p_m: [f64; 2]) -> FrameJacobian {
 }
 
 /// ∂U/∂s · ∇s + ∂U/∂d · ∇d: a frame gradient mapped to the world (Eq. 7 in the lane frame).
-pub fn to_world_gradient(j: &FrameJacobian, du_ds: f64, du_dd: f64) -> [f64; 2] {
+pub(crate) fn to_world_gradient(j: &FrameJacobian, du_ds: f64, du_dd: f64) -> [f64; 2] {
     [
         du_ds * j.grad_s[0] + du_dd * j.grad_d[0],
         du_ds * j.grad_s[1] + du_dd * j.grad_d[1],

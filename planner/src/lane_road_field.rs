@@ -19,8 +19,8 @@
 //!   to the edge (positive on the road), e the straight road's ½ ξ/g² with its linear
 //!   continuation below g_c (`road_field.rs`).
 //! - **Lane-end rule**: a vehicle in a lane that goes on sees the divider towards a neighbour
-//!   that ends as Eq. 3's edge, cut off at [`LANE_END_WALL_CUTOFF_M`] ([`wall_term`],
-//!   [`LaneRoadGeometry::lane_end_walls`]).
+//!   that ends as Eq. 3's edge, cut off at `LANE_END_WALL_CUTOFF_M` (`wall_term`,
+//!   `LaneRoadGeometry::lane_end_walls`).
 //! - **Eq. 7**: ∇U = ∂U/∂s ∇s + ∂U/∂d ∇d (`lane_frame.rs`); the edge term's gradient is the
 //!   distance's own, e'(g)·∇δ.
 //!
@@ -59,12 +59,12 @@ struct DividerGeometry {
 /// zero, so a vehicle near its lane's centre (clearance (w − l_w)/2 = 0.945 m for a 1.61 m car
 /// in a 3.5 m lane) sees the same field as without the rule, and only a path pushed towards
 /// the lane that ends meets it.
-pub const LANE_END_WALL_CUTOFF_M: f64 = 0.5;
+pub(crate) const LANE_END_WALL_CUTOFF_M: f64 = 0.5;
 
 /// The lane-end wall's term at body clearance g and its slope: Eq. 3's e(g) (with its linear
 /// continuation below g_c) less its tangent at the cut-off g_w = [`LANE_END_WALL_CUTOFF_M`],
 /// zero beyond g_w: e(g) − e(g_w) − e'(g_w)(g − g_w), C¹ at g_w.
-pub fn wall_term(gain_m2: f64, clamp_m: f64, clearance_m: f64) -> (f64, f64) {
+pub(crate) fn wall_term(gain_m2: f64, clamp_m: f64, clearance_m: f64) -> (f64, f64) {
     let cut = LANE_END_WALL_CUTOFF_M;
     if clearance_m >= cut {
         return (0.0, 0.0);
@@ -159,12 +159,12 @@ impl LaneRoadGeometry {
     }
 
     /// The road.
-    pub fn road(&self) -> &LaneRoad {
+    pub(crate) fn road(&self) -> &LaneRoad {
         &self.road
     }
 
     /// The road, shared.
-    pub fn shared_road(&self) -> &Arc<LaneRoad> {
+    pub(crate) fn shared_road(&self) -> &Arc<LaneRoad> {
         &self.road
     }
 
@@ -195,7 +195,7 @@ impl LaneRoadGeometry {
 
     /// Arc length s of a point in lane `lane`'s frame (m).
     #[inline]
-    pub fn s_m(&self, lane: usize, p_m: [f64; 2]) -> f64 {
+    pub(crate) fn s_m(&self, lane: usize, p_m: [f64; 2]) -> f64 {
         self.frames[lane]
             .project(self.road.lanes()[lane].centreline(), p_m)
             .s_m
@@ -204,7 +204,7 @@ impl LaneRoadGeometry {
     /// Index of the lane holding the point and the point's (s, d) in it: as
     /// [`LaneRoad::nearest_lane`] (smallest frame excess, ties to the smaller |d|, then to the
     /// description order), through the prepared frames.
-    pub fn lane_at(&self, p_m: [f64; 2]) -> (usize, FramePoint) {
+    pub(crate) fn lane_at(&self, p_m: [f64; 2]) -> (usize, FramePoint) {
         let mut best: Option<(usize, FramePoint, f64)> = None;
         for (i, l) in self.road.lanes().iter().enumerate() {
             let fp = self.frames[i].project(l.centreline(), p_m);
@@ -219,12 +219,12 @@ impl LaneRoadGeometry {
     }
 
     /// Index of the lane holding the point ([`LaneRoadGeometry::lane_at`]).
-    pub fn lane_index_at(&self, p_m: [f64; 2]) -> usize {
+    pub(crate) fn lane_index_at(&self, p_m: [f64; 2]) -> usize {
         self.lane_at(p_m).0
     }
 
     /// The smoothed heading of lane `lane` at `s_m` (rad; a straight lane's direction).
-    pub fn lane_heading_rad(&self, lane: usize, s_m: f64) -> f64 {
+    pub(crate) fn lane_heading_rad(&self, lane: usize, s_m: f64) -> f64 {
         match &self.frames[lane] {
             FastFrame::Straight { tangent, .. } => tangent[1].atan2(tangent[0]),
             FastFrame::General => self.road.lanes()[lane].heading_rad(s_m),
@@ -232,7 +232,7 @@ impl LaneRoadGeometry {
     }
 
     /// On which side of lane `lane` its neighbour `other` lies (across a divider).
-    pub fn side_of_neighbour(&self, lane: usize, other: usize) -> Option<Side> {
+    pub(crate) fn side_of_neighbour(&self, lane: usize, other: usize) -> Option<Side> {
         self.dividers.iter().find_map(|dg| {
             if dg.right_lane == lane && dg.left_lane == other {
                 Some(Side::Left)
@@ -245,7 +245,7 @@ impl LaneRoadGeometry {
     }
 
     /// The unit tangent of lane `lane` if its centreline is straight.
-    pub fn straight_tangent(&self, lane: usize) -> Option<[f64; 2]> {
+    pub(crate) fn straight_tangent(&self, lane: usize) -> Option<[f64; 2]> {
         match &self.frames[lane] {
             FastFrame::Straight { tangent, .. } => Some(*tangent),
             FastFrame::General => None,
@@ -254,7 +254,7 @@ impl LaneRoadGeometry {
 
     /// The heading of the lane holding the point, at the point's s (rad): Eq. 4's reference
     /// for an obstacle's heading.
-    pub fn lane_heading_at_rad(&self, p_m: [f64; 2]) -> f64 {
+    pub(crate) fn lane_heading_at_rad(&self, p_m: [f64; 2]) -> f64 {
         let (lane, fp) = self.lane_at(p_m);
         self.lane_heading_rad(lane, fp.s_m)
     }
@@ -339,7 +339,7 @@ impl LaneRoadGeometry {
     /// appears without a jolt: a vehicle that has just merged meets no wall pushing at it), or
     /// settled at its previous cycle in the same lane (`settled_lane`, the lane index) — then
     /// they stay while its centre is in that lane, however close a push brings it.
-    pub fn lane_end_walls(
+    pub(crate) fn lane_end_walls(
         &self,
         state: &VehicleState,
         half_width_m: f64,
@@ -427,7 +427,7 @@ impl<'g> LaneRoadField<'g> {
     /// The field of a vehicle in `state`, with the lane-end rule's walls when
     /// `lane_end_walls` ([`LaneRoadGeometry::lane_end_walls`] without a previous cycle:
     /// walls only if the vehicle is settled now): [`wall_term`] along each, in d − d_div(s).
-    pub fn for_vehicle(
+    pub(crate) fn for_vehicle(
         geometry: &'g LaneRoadGeometry,
         params: &RoadFieldParams,
         lane_end_walls: bool,
@@ -496,7 +496,7 @@ impl<'g> LaneRoadField<'g> {
 
     /// The lane-end walls' term at (x, y): [`wall_term`] of the body clearance
     /// g = sign·(d − d_div) − l_w/2 per wall (Eq. 3's edge, cut off at [`LANE_END_WALL_CUTOFF_M`]).
-    pub fn wall_value(&self, x_m: f64, y_m: f64) -> f64 {
+    pub(crate) fn wall_value(&self, x_m: f64, y_m: f64) -> f64 {
         if self.walls.is_empty() {
             return 0.0;
         }
@@ -510,7 +510,7 @@ impl<'g> LaneRoadField<'g> {
         v
     }
 
-    /// ∇ of [`LaneRoadField::wall_value`]: w'(g)·sign·(∇d − d_div'·∇s).
+    /// ∇ of `LaneRoadField::wall_value`: w'(g)·sign·(∇d − d_div'·∇s).
     pub fn wall_gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
         let mut g = [0.0, 0.0];
         if self.walls.is_empty() {

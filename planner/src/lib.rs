@@ -4,47 +4,61 @@
 //! No physics engine, no logging backend: plain state in, plan out, so it can run on a car.
 //! `planner/README.md` maps each equation of the paper to the function implementing it and
 //! lists every reading of a typo or unit problem.
+//!
+//! # Public API
+//! - The planner: [`PfPlanner`] (a [`Behaviour`](mergesim_types::Behaviour)) of a [`PlannerKind`], built
+//!   from [`PlannerParams`] (or a named [`ParameterSet`]); one planning step takes a
+//!   [`PlanRequest`] and gives a [`Plan`] (or a [`PlannerError`]), with [`PlanStats`] and, when it
+//!   fell back, a [`FallbackReason`].
+//! - Its parameters: [`PlannerParams`], [`SlpReading`], [`SpeedProgram`], [`V2vLossFallback`] and
+//!   the tables of a scenario's `[planner.*]` keys, [`params_tables`].
+//! - The fields and steps, usable on their own: [`PotentialField`] on a
+//!   [`GridSpec`](mergesim_types::GridSpec),
+//!   [`attractive_field`], [`obstacle_field`], [`road_field`], [`lane_road_field`],
+//!   [`lane_frame`], [`local_path`], [`cubic_fit`], [`speed_optimisation`], [`SpeedProfile`],
+//!   [`fallback`], [`following`] and [`others`].
+//! - The plain data it speaks (vehicle state and shape, path points, shared local paths, the
+//!   merge road) is [`mergesim_types`]'.
 #![warn(missing_docs)]
 
 pub mod attractive_field;
-pub mod behaviour;
+pub(crate) mod behaviour;
 mod clarabel_setup;
 pub mod cubic_fit;
 pub mod derived_params;
 pub mod error;
 pub mod fallback;
-pub mod field_params;
+pub(crate) mod field_params;
 pub mod following;
 pub mod lane_frame;
 mod lane_road_edges;
 pub mod lane_road_field;
 mod lane_road_frames;
 pub mod local_path;
-pub mod min_distance;
+pub(crate) mod min_distance;
 pub mod obstacle_field;
 pub mod others;
-pub mod parameter_set;
+pub(crate) mod parameter_set;
 pub mod params;
 pub mod params_tables;
-pub mod planners;
+pub(crate) mod planners;
 pub mod polyline;
-pub mod potential_field;
-pub mod prediction;
-pub mod request;
-pub mod road;
+pub(crate) mod potential_field;
+pub(crate) mod prediction;
+pub(crate) mod request;
+pub(crate) mod road;
 pub mod road_field;
 pub mod speed_optimisation;
 pub mod speed_profile;
-pub mod stop_and_go;
-pub mod types;
+pub(crate) mod stop_and_go;
+pub(crate) mod types;
 
 pub use error::PlannerError;
 pub use following::V2vLossFallback;
-pub use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
 pub use parameter_set::ParameterSet;
 pub use params::{PlannerParams, SlpReading};
 pub use planners::{PfPlanner, PlanRequest, PlanStats, PlannerKind};
-pub use potential_field::{GridSpec, PotentialField};
+pub use potential_field::PotentialField;
 pub use road::{Lane, MergeRoad};
 pub use speed_optimisation::SpeedProgram;
 pub use speed_profile::SpeedProfile;

@@ -13,7 +13,7 @@
 //! −1.47 rad on consecutive sub-steps). Where a waypoint lands in that zig-zag depends chaotically
 //! on the start pose, so consecutive plans (0.1 s apart) moved their far waypoints by ±0.5 m, the
 //! cubic fit of Eq. 9 carried that into the near path (±0.2 m at the tracker's look-ahead) and
-//! the follower's yaw rate chattered at ±0.03 rad/s. [`local_path_adaptive`] therefore halves a
+//! the follower's yaw rate chattered at ±0.03 rad/s. `local_path_adaptive` therefore halves a
 //! sub-step while ψ_ref turns by more than a set angle across it: an explicit streamline
 //! integrator with step-size control, which leaves the path unchanged where the field is smooth.
 
@@ -24,7 +24,7 @@ use crate::potential_field::PotentialField;
 /// obstacles move at constant velocity while stepping (waypoint k is reached at k·Δt);
 /// 0 keeps them where they are now, as in the paper.
 ///
-/// Fixed sub-steps: [`local_path_adaptive`] with no turn limit.
+/// Fixed sub-steps: `local_path_adaptive` with no turn limit.
 pub fn local_path(
     field: &PotentialField<'_>,
     start_xy_m: [f64; 2],
@@ -55,7 +55,7 @@ const MAX_SUBSTEP_HALVINGS: i32 = 6;
 /// the fixed sub-step, which is then accepted), and doubled again after each accepted sub-step.
 /// Each waypoint is still exactly `step_m` of path length after the previous one.
 /// `max_turn_rad` = 0 (or not finite) gives the fixed sub-steps of [`local_path`] bit for bit.
-pub fn local_path_adaptive(
+pub(crate) fn local_path_adaptive(
     field: &PotentialField<'_>,
     start_xy_m: [f64; 2],
     step_m: f64,

@@ -75,7 +75,7 @@ pub struct ObstacleField {
 
 /// Which half of the field a point lies in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Side {
+pub(crate) enum Side {
     /// Ahead of the obstacle (σ_front).
     Front,
     /// Behind it (σ_rear).
@@ -85,7 +85,7 @@ pub enum Side {
 impl ObstacleField {
     /// The field of a vehicle at (x, y, ψ) with `other_speed_mps` and `other_shape`, seen by
     /// the planning vehicle `me` (σ's as in the module doc).
-    pub fn new(
+    pub(crate) fn new(
         params: &ObstacleFieldParams,
         me: SelfView,
         x_m: f64,
@@ -116,7 +116,7 @@ impl ObstacleField {
     /// the obstacle (Eq. 4 on a road of lanes): the correlation form is then written in the
     /// lane's axes, so a rotated copy of the road gives the same field. A lane along +x
     /// (heading 0) leaves the field as it is.
-    pub fn in_lane_frame(self, lane_heading_rad: f64) -> Self {
+    pub(crate) fn in_lane_frame(self, lane_heading_rad: f64) -> Self {
         if lane_heading_rad == 0.0 {
             return self;
         }
@@ -132,7 +132,7 @@ impl ObstacleField {
     /// The same field with its front half shrunk to the contact distance (l + l_o)/2: only the
     /// vehicle behind keeps the speed-dependent gap (the follower is responsible for it, as in
     /// RSS). Used by the interaction term of Eq. 10 when `interaction_rear_only` is set.
-    pub fn rear_only(&self, contact_m: f64, x_scale: f64) -> Self {
+    pub(crate) fn rear_only(&self, contact_m: f64, x_scale: f64) -> Self {
         Self {
             sigma_front_m: contact_m / x_scale,
             ..*self
@@ -142,7 +142,7 @@ impl ObstacleField {
     /// The same field shrunk to the contact distance on both sides: what a leader sees of the
     /// vehicle behind it when the roles are fixed from the order now (the follower keeps the
     /// gap, however their predicted positions develop).
-    pub fn contact_only(&self, contact_m: f64, x_scale: f64) -> Self {
+    pub(crate) fn contact_only(&self, contact_m: f64, x_scale: f64) -> Self {
         Self {
             sigma_front_m: contact_m / x_scale,
             sigma_rear_m: contact_m / x_scale,
@@ -151,7 +151,7 @@ impl ObstacleField {
     }
 
     /// The field with `role` applied ([`Role::Full`] leaves it as it is).
-    pub fn with_role(&self, role: Role, contact_m: f64, x_scale: f64) -> Self {
+    pub(crate) fn with_role(&self, role: Role, contact_m: f64, x_scale: f64) -> Self {
         match role {
             Role::Full => *self,
             Role::RearOnly => self.rear_only(contact_m, x_scale),
@@ -160,7 +160,7 @@ impl ObstacleField {
     }
 
     /// The same field moved to another centre and heading (same σ's).
-    pub fn moved_to(&self, x_m: f64, y_m: f64, cos_heading: f64, sin_heading: f64) -> Self {
+    pub(crate) fn moved_to(&self, x_m: f64, y_m: f64, cos_heading: f64, sin_heading: f64) -> Self {
         Self {
             x_m,
             y_m,
@@ -174,7 +174,7 @@ impl ObstacleField {
     }
 
     /// The side of the field a point is on.
-    pub fn side(&self, x_m: f64, y_m: f64) -> Side {
+    pub(crate) fn side(&self, x_m: f64, y_m: f64) -> Side {
         let dx = x_m - self.x_m;
         let along = match self.heading_form {
             HeadingForm::Rotation => self.cos_heading * dx + self.sin_heading * (y_m - self.y_m),
@@ -231,17 +231,17 @@ impl ObstacleField {
     }
 
     /// The exponent q with U = A·exp(−q) (q ≥ 0).
-    pub fn exponent(&self, x_m: f64, y_m: f64) -> f64 {
+    pub(crate) fn exponent(&self, x_m: f64, y_m: f64) -> f64 {
         self.exponent_and_derivatives(x_m, y_m).0
     }
 
     /// U_OB at (x, y), Eq. 4.
-    pub fn value(&self, x_m: f64, y_m: f64) -> f64 {
+    pub(crate) fn value(&self, x_m: f64, y_m: f64) -> f64 {
         self.amplitude * (-self.exponent(x_m, y_m)).exp()
     }
 
     /// U_OB and its gradient with respect to the evaluated point (x, y).
-    pub fn value_and_gradient(&self, x_m: f64, y_m: f64) -> (f64, [f64; 2]) {
+    pub(crate) fn value_and_gradient(&self, x_m: f64, y_m: f64) -> (f64, [f64; 2]) {
         let (q, dq, _) = self.exponent_and_derivatives(x_m, y_m);
         let u = self.amplitude * (-q).exp();
         (u, [-u * dq[0], -u * dq[1]])
@@ -249,14 +249,14 @@ impl ObstacleField {
 
     /// U_OB, the side, and ∂U/∂σ_x of that side at a fixed point (the paper's reading of
     /// U_SLP, where speed enters only through D_min).
-    pub fn value_and_sigma_derivative(&self, x_m: f64, y_m: f64) -> (f64, Side, f64) {
+    pub(crate) fn value_and_sigma_derivative(&self, x_m: f64, y_m: f64) -> (f64, Side, f64) {
         let (q, _, dq_dsigma) = self.exponent_and_derivatives(x_m, y_m);
         let u = self.amplitude * (-q).exp();
         (u, self.side(x_m, y_m), -u * dq_dsigma)
     }
 
     /// ∇U_OB at (x, y).
-    pub fn gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
+    pub(crate) fn gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
         self.value_and_gradient(x_m, y_m).1
     }
 }

@@ -1,7 +1,7 @@
 //! What a planning vehicle knows about the others for its speed choice (Eq. 10 and PF-SP), and
 //! the non-convex speed terms built from it.
 //!
-//! Each other vehicle comes with a [`Trajectory`]: its received shared local path (PF-ISO, if
+//! Each other vehicle comes with a `Trajectory`: its received shared local path (PF-ISO, if
 //! fresh) or a prediction from its perceived state (`PlannerParams::prediction`; PF-ISO-PRED and
 //! PF-SP always, PF-ISO for a vehicle without a fresh SLP), and whether it is ahead of the
 //! planning vehicle *now* (larger s along the ego's lane).
@@ -130,7 +130,7 @@ pub fn gather_others(
 
 /// How the roles shape one other vehicle's field (module doc).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RoleRules {
+pub(crate) struct RoleRules {
     /// Per-slot roles for received SLPs: the front shrunk to the contact distance.
     pub rear_only: bool,
     /// Fixed roles from the order now for predicted vehicles.

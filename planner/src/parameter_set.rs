@@ -45,7 +45,7 @@ pub enum ParameterSet {
 
 impl ParameterSet {
     /// Every set, in a fixed order.
-    pub const ALL: [ParameterSet; 2] = [ParameterSet::Paper, ParameterSet::Mergesim];
+    pub(crate) const ALL: [ParameterSet; 2] = [ParameterSet::Paper, ParameterSet::Mergesim];
 
     /// The name used on the command line and in scenario files.
     pub fn name(self) -> &'static str {

@@ -531,7 +531,7 @@ impl PlannerParams {
     }
 
     /// The obstacle fields of the path (Eq. 7) and of PF-SP's risk term.
-    pub fn path_field(&self) -> ObstacleFieldParams {
+    pub(crate) fn path_field(&self) -> ObstacleFieldParams {
         ObstacleFieldParams {
             amplitude: self.obstacle_amplitude,
             epsilon: self.obstacle_epsilon,
@@ -543,7 +543,7 @@ impl PlannerParams {
     }
 
     /// The obstacle fields of the interaction term U_SLP (Eq. 10).
-    pub fn interaction_field(&self) -> ObstacleFieldParams {
+    pub(crate) fn interaction_field(&self) -> ObstacleFieldParams {
         ObstacleFieldParams {
             amplitude: self.obstacle_amplitude,
             epsilon: self.interaction_epsilon,
@@ -575,7 +575,7 @@ impl PlannerParams {
     }
 
     /// Waypoint step L_s = max(v·Δt_plan, L_min) for a speed (m).
-    pub fn step_length_m(&self, speed_mps: f64) -> f64 {
+    pub(crate) fn step_length_m(&self, speed_mps: f64) -> f64 {
         (speed_mps.max(0.0) * self.step_time_s).max(self.min_step_m)
     }
 }

@@ -112,7 +112,7 @@ pub struct PlanStats {
     /// Convex speed solves of the cycle.
     pub speed_solves: usize,
     /// Whether the speed optimisation's SCP stopped at `max_scp_iterations` before meeting its
-    /// tolerance ([`SpeedSolution::stopped_at_iteration_cap`](crate::speed_optimisation::SpeedSolution)).
+    /// tolerance (`SpeedSolution::stopped_at_iteration_cap`).
     pub speed_stopped_at_iteration_cap: bool,
     /// Whether the cubic fit needed the QP (a bound was active).
     pub cubic_qp: bool,
@@ -301,7 +301,7 @@ impl PfPlanner {
     }
 
     /// U on a grid (row after row, cell centres; see [`GridSpec`]).
-    pub fn field_grid(
+    pub(crate) fn field_grid(
         &self,
         req: &PlanRequest<'_>,
         spec: &GridSpec,

@@ -18,7 +18,7 @@ impl Polyline {
     }
 
     /// A polyline starting at `start` (never empty, so this cannot fail).
-    pub fn with_start(start: [f64; 2], rest: impl IntoIterator<Item = [f64; 2]>) -> Self {
+    pub(crate) fn with_start(start: [f64; 2], rest: impl IntoIterator<Item = [f64; 2]>) -> Self {
         let mut points = vec![start];
         points.extend(rest);
         let mut arc_m = Vec::with_capacity(points.len());
@@ -32,12 +32,12 @@ impl Polyline {
     }
 
     /// The vertices.
-    pub fn points(&self) -> &[[f64; 2]] {
+    pub(crate) fn points(&self) -> &[[f64; 2]] {
         &self.points
     }
 
     /// Cumulative arc length at each vertex (m).
-    pub fn arc_lengths_m(&self) -> &[f64] {
+    pub(crate) fn arc_lengths_m(&self) -> &[f64] {
         &self.arc_m
     }
 
@@ -47,14 +47,18 @@ impl Polyline {
     }
 
     /// Lengths of the segments (m), one fewer than the points.
-    pub fn segment_lengths_m(&self) -> Vec<f64> {
+    pub(crate) fn segment_lengths_m(&self) -> Vec<f64> {
         self.arc_m.windows(2).map(|w| w[1] - w[0]).collect()
     }
 
     /// Point and unit tangent at arc length `s_m`. Before the start and past the end the
     /// polyline continues straight along its first / last non-degenerate segment; a polyline
     /// of one point (or of coincident points) has tangent `fallback_tangent`.
-    pub fn point_and_tangent(&self, s_m: f64, fallback_tangent: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+    pub(crate) fn point_and_tangent(
+        &self,
+        s_m: f64,
+        fallback_tangent: [f64; 2],
+    ) -> ([f64; 2], [f64; 2]) {
         let n = self.points.len();
         // Index k of the segment [k, k+1] holding s (clamped to the first / last).
         let k = self

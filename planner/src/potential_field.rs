@@ -14,7 +14,7 @@ use crate::obstacle_field::{ObstacleField, ObstacleFieldParams, SelfView};
 use crate::road_field::RoadFieldParams;
 use crate::types::{Neighbour, VehicleId, VehicleShape, VehicleState};
 
-pub use mergesim_types::{GridSpec, MAX_GRID_CELLS};
+pub(crate) use mergesim_types::GridSpec;
 
 /// The numbers of the universal field U_uni = U_AT + U_LD + U_RE + Σ_j U_OB^j (Eq. 5), built
 /// once from `PlannerParams` (`derived_params`; `UniversalFieldParams::from(&params)`).
@@ -46,7 +46,7 @@ pub struct PotentialField<'a> {
     pub road: LaneRoadField<'a>,
     /// Eq. 4, one per other vehicle, in the order of the neighbours given.
     pub obstacles: Vec<ObstacleField>,
-    /// Each obstacle's velocity (m/s), for [`PotentialField::stepping_force_at`].
+    /// Each obstacle's velocity (m/s), for `PotentialField::stepping_force_at`.
     pub obstacle_velocities_mps: Vec<[f64; 2]>,
 }
 
@@ -109,7 +109,7 @@ impl<'a> PotentialField<'a> {
 
     /// U_AT at (x, y), Eq. 1 with the target fixed at the ego's s + look-ahead on the target
     /// lane: ½ λ (s − s_tar)².
-    pub fn attractive_value(&self, x_m: f64, y_m: f64) -> f64 {
+    pub(crate) fn attractive_value(&self, x_m: f64, y_m: f64) -> f64 {
         let ds = self.road.geometry.s_m(self.target_lane, [x_m, y_m]) - self.target_s_m;
         0.5 * self.attractive_gain_per_m2 * ds * ds
     }
@@ -124,7 +124,7 @@ impl<'a> PotentialField<'a> {
     /// ∇U_AT with the target re-anchored a look-ahead ahead of (x, y) along the target lane
     /// (Eq. 1, reading 1): −λ·look-ahead·∇s (on a straight road along +x the constant
     /// [−λ·look-ahead, 0]).
-    pub fn moving_target_gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
+    pub(crate) fn moving_target_gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
         let j = self.road.geometry.jacobian(self.target_lane, [x_m, y_m]);
         let k = -self.attractive_gain_per_m2 * self.lookahead_m;
         [k * j.grad_s[0], k * j.grad_s[1]]
@@ -132,7 +132,7 @@ impl<'a> PotentialField<'a> {
 
     /// U_LD + U_RE + Σ U_OB: everything but the attraction (what a drawing usually wants:
     /// the attraction is a bowl of size ½ λ Δs² that swamps the rest).
-    pub fn repulsive_value(&self, x_m: f64, y_m: f64) -> f64 {
+    pub(crate) fn repulsive_value(&self, x_m: f64, y_m: f64) -> f64 {
         self.road.value(x_m, y_m)
             + self
                 .obstacles
@@ -147,7 +147,7 @@ impl<'a> PotentialField<'a> {
     }
 
     /// ∇(U_LD + U_RE + Σ U_OB).
-    pub fn repulsive_gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
+    pub(crate) fn repulsive_gradient(&self, x_m: f64, y_m: f64) -> [f64; 2] {
         let mut g = self.road.gradient(x_m, y_m);
         for o in &self.obstacles {
             let go = o.gradient(x_m, y_m);
@@ -176,7 +176,7 @@ impl<'a> PotentialField<'a> {
 
     /// [`PotentialField::stepping_force`] with every obstacle moved along its velocity for
     /// `elapsed_s` (constant-velocity prediction; 0 gives the current positions).
-    pub fn stepping_force_at(&self, x_m: f64, y_m: f64, elapsed_s: f64) -> [f64; 2] {
+    pub(crate) fn stepping_force_at(&self, x_m: f64, y_m: f64, elapsed_s: f64) -> [f64; 2] {
         if elapsed_s == 0.0 {
             return self.stepping_force(x_m, y_m);
         }
@@ -192,7 +192,7 @@ impl<'a> PotentialField<'a> {
     }
 
     /// Samples U (with or without the attraction) on a grid, row after row.
-    pub fn grid(
+    pub(crate) fn grid(
         &self,
         spec: &GridSpec,
         include_attractive: bool,

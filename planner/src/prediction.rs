@@ -27,7 +27,7 @@ pub enum PredictionModel {
 
 impl PredictionModel {
     /// The prediction of a vehicle in `state` at `time_s` on `road`.
-    pub fn trajectory(
+    pub(crate) fn trajectory(
         self,
         state: VehicleState,
         time_s: f64,
@@ -75,7 +75,7 @@ impl PartialEq for LaneFollowing {
 
 impl LaneFollowing {
     /// The prediction of a vehicle in `state` at `time_s` on `road`.
-    pub fn new(state: VehicleState, time_s: f64, road: &LaneRoadGeometry) -> Self {
+    pub(crate) fn new(state: VehicleState, time_s: f64, road: &LaneRoadGeometry) -> Self {
         let p = [state.x_m, state.y_m];
         let (lane, fp) = road.lane_at(p);
         let l = &road.road().lanes()[lane];
@@ -107,7 +107,7 @@ impl LaneFollowing {
     }
 
     /// Pose at absolute time `t_s`.
-    pub fn pose_at(&self, t_s: f64) -> PredictedPose {
+    pub(crate) fn pose_at(&self, t_s: f64) -> PredictedPose {
         let travelled_m = self.state.speed_mps * (t_s - self.time_s);
         let l = &self.road.lanes()[self.lane];
         let s_m = self.s0_m + travelled_m * self.ds_per_m;
@@ -150,7 +150,7 @@ impl LaneFollowing {
 
 /// A predicted pose: position and unit heading vector (cos ψ, sin ψ).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PredictedPose {
+pub(crate) struct PredictedPose {
     /// Position (m).
     pub xy_m: [f64; 2],
     /// (cos ψ, sin ψ).
@@ -183,7 +183,7 @@ pub enum Trajectory {
 impl Trajectory {
     /// The SLP of `message` (points not later than their predecessor are dropped). `None` if it
     /// holds no usable waypoint.
-    pub fn from_shared(message: &SharedLocalPath, fallback_yaw_rad: f64) -> Option<Self> {
+    pub(crate) fn from_shared(message: &SharedLocalPath, fallback_yaw_rad: f64) -> Option<Self> {
         let mut waypoints: Vec<TimedWaypoint> = Vec::with_capacity(message.waypoints.len());
         for w in &message.waypoints {
             if !(w.t_s.is_finite() && w.x_m.is_finite() && w.y_m.is_finite()) {
@@ -204,13 +204,13 @@ impl Trajectory {
     }
 
     /// Whether this is a prediction (not a received shared path).
-    pub fn is_predicted(&self) -> bool {
+    pub(crate) fn is_predicted(&self) -> bool {
         !matches!(self, Self::Shared { .. })
     }
 
     /// Speed along the trajectory at absolute time `t_s` (m/s): the state's speed for a
     /// prediction, the speed of the segment of a shared path.
-    pub fn speed_at(&self, t_s: f64) -> f64 {
+    pub(crate) fn speed_at(&self, t_s: f64) -> f64 {
         match self {
             Self::ConstantVelocity { state, .. } => state.speed_mps,
             Self::LaneFollowing(f) => f.state.speed_mps,
@@ -230,7 +230,7 @@ impl Trajectory {
     }
 
     /// Pose at absolute time `t_s`.
-    pub fn pose_at(&self, t_s: f64) -> PredictedPose {
+    pub(crate) fn pose_at(&self, t_s: f64) -> PredictedPose {
         match self {
             Self::LaneFollowing(f) => f.pose_at(t_s),
             Self::ConstantVelocity { state, time_s } => {

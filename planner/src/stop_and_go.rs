@@ -129,18 +129,18 @@ pub fn stop_and_go_caps_mps(
 }
 
 /// Lowers each speed above its cap to the cap (module doc, item 3).
-pub fn apply_caps(speeds_mps: &mut [f64], caps_mps: &[f64]) {
+pub(crate) fn apply_caps(speeds_mps: &mut [f64], caps_mps: &[f64]) {
     for (v, cap) in speeds_mps.iter_mut().zip(caps_mps) {
         *v = v.min(*cap);
     }
 }
 
 /// Speed floor of a planned path's *times* at standstill (m/s; module doc, item 4).
-pub const STANDSTILL_TIMING_SPEED_MPS: f64 = 0.01;
+pub(crate) const STANDSTILL_TIMING_SPEED_MPS: f64 = 0.01;
 
 /// Time to drive a segment of `length_m` at `speed_mps` (s), with the speed floored at
 /// [`STANDSTILL_TIMING_SPEED_MPS`] in the time only (module doc, item 4).
-pub fn segment_time_s(length_m: f64, speed_mps: f64) -> f64 {
+pub(crate) fn segment_time_s(length_m: f64, speed_mps: f64) -> f64 {
     length_m / speed_mps.max(STANDSTILL_TIMING_SPEED_MPS)
 }
 

@@ -20,7 +20,7 @@ use crate::errors::BindingError;
 const SIGNAL_POLL: Duration = Duration::from_millis(100);
 
 /// A rayon pool of `threads` threads (`None`: one per core), created now, in this process.
-pub fn fresh_pool(threads: Option<usize>) -> PyResult<Arc<rayon::ThreadPool>> {
+pub(crate) fn fresh_pool(threads: Option<usize>) -> PyResult<Arc<rayon::ThreadPool>> {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
@@ -31,7 +31,11 @@ pub fn fresh_pool(threads: Option<usize>) -> PyResult<Arc<rayon::ThreadPool>> {
 /// Runs `work(interrupt)` on a pool of `threads` created for it, without the GIL; a signal
 /// handler that raises (Ctrl-C: `KeyboardInterrupt`) sets `interrupt`, and its exception is
 /// returned once the work has stopped.
-pub fn run_interruptible<T, F>(py: Python<'_>, threads: Option<usize>, work: F) -> PyResult<T>
+pub(crate) fn run_interruptible<T, F>(
+    py: Python<'_>,
+    threads: Option<usize>,
+    work: F,
+) -> PyResult<T>
 where
     T: Send,
     F: FnOnce(Arc<AtomicBool>) -> T + Send,

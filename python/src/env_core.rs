@@ -16,7 +16,7 @@ use crate::external::{Command, EXTERNAL_PLANNER, External, SharedCommand};
 use crate::source;
 
 /// Columns of a vehicle's state row ([`EnvCore::reset`], [`EnvCore::step`]).
-pub const STATE_COLUMNS: [&str; 9] = [
+pub(crate) const STATE_COLUMNS: [&str; 9] = [
     "x_m",
     "y_m",
     "yaw_rad",
@@ -72,7 +72,7 @@ type StepResult = (
 /// The simulation behind `mergesim.MergeEnv` (module doc). Not thread-safe: used from the thread
 /// that made it.
 #[pyclass(unsendable, module = "mergesim._native")]
-pub struct EnvCore {
+pub(crate) struct EnvCore {
     scenario: Scenario,
     planner: Option<String>,
     agent: usize,

@@ -24,7 +24,7 @@ create_exception!(
 
 /// Why a call of the bindings failed.
 #[derive(Debug, Error)]
-pub enum BindingError {
+pub(crate) enum BindingError {
     /// Bad input (exit code 2 in the CLI).
     #[error("{0}")]
     Input(String),
@@ -35,12 +35,12 @@ pub enum BindingError {
 
 impl BindingError {
     /// Bad input, with `error`'s causes (as the CLI prints it).
-    pub fn input(error: &(dyn std::error::Error + 'static)) -> Self {
+    pub(crate) fn input(error: &(dyn std::error::Error + 'static)) -> Self {
         Self::Input(chain(error))
     }
 
     /// A failure while running, with `error`'s causes.
-    pub fn run(error: &(dyn std::error::Error + 'static)) -> Self {
+    pub(crate) fn run(error: &(dyn std::error::Error + 'static)) -> Self {
         Self::Run(chain(error))
     }
 }
@@ -56,7 +56,7 @@ impl From<BindingError> for PyErr {
 
 /// `error` and its sources joined by `: ` (what `eprintln!("error: {e:#}")` prints of an
 /// `anyhow::Error` after `error: `).
-pub fn chain(error: &(dyn std::error::Error + 'static)) -> String {
+pub(crate) fn chain(error: &(dyn std::error::Error + 'static)) -> String {
     let mut text = error.to_string();
     let mut source = error.source();
     while let Some(cause) = source {

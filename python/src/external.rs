@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 use sim::{Behaviour, BehaviourError, Decision, Observation, PathPoint};
 
 /// Name the behaviour is registered under (for the agent's vehicle only).
-pub const EXTERNAL_PLANNER: &str = "external";
+pub(crate) const EXTERNAL_PLANNER: &str = "external";
 
 /// Spacing of the commanded path's points (m).
 const STEP_M: f64 = 2.5;
@@ -23,7 +23,7 @@ const MIN_TIMING_SPEED_MPS: f64 = 0.5;
 
 /// The last action: what the agent's vehicle is asked to do until the next one.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Command {
+pub(crate) struct Command {
     /// Speed to drive at (m/s, ≥ 0).
     pub target_speed_mps: f64,
     /// Lateral position to drive at (m, the road's y).
@@ -32,17 +32,17 @@ pub struct Command {
 
 /// The commanded path, shared between the environment (which writes the command) and the
 /// vehicle's behaviour (which reads it at every planning cycle).
-pub type SharedCommand = Arc<Mutex<Command>>;
+pub(crate) type SharedCommand = Arc<Mutex<Command>>;
 
 /// The agent's behaviour (module doc).
-pub struct External {
+pub(crate) struct External {
     /// The command it follows.
     pub command: SharedCommand,
 }
 
 /// The path of `command` from the vehicle at (`x_m`, `y_m`) at time `t_s`: straight ahead at
 /// the commanded speed, moving smoothly (a cosine blend) to the commanded lateral position.
-pub fn commanded_path(command: Command, x_m: f64, y_m: f64, t_s: f64) -> Vec<PathPoint> {
+pub(crate) fn commanded_path(command: Command, x_m: f64, y_m: f64, t_s: f64) -> Vec<PathPoint> {
     let v = command.target_speed_mps.max(0.0);
     let length_m = (LENGTH_S * v).max(MIN_LENGTH_M);
     let transition_m = (TRANSITION_S * v).max(MIN_TRANSITION_M);

@@ -1,6 +1,10 @@
 //! `mergesim._native`: the Rust half of the `mergesim` Python package (python/README.md).
 //! Scenarios load as in `merge_sim` (built-in name, path, or TOML text); bad input raises
 //! `ScenarioError` with the CLI's message; the simulations run without the GIL.
+//!
+//! # Public API
+//! None in Rust (every module is private): the API is the Python module `mergesim._native`,
+//! whose functions and classes `_native` registers.
 
 mod background;
 mod env_core;

@@ -41,7 +41,7 @@ fn table() -> std::sync::MutexGuard<'static, BTreeMap<String, Arc<Py<PyAny>>>> {
 }
 
 /// The built-in planners plus the Python planners registered now.
-pub fn registry() -> Result<BehaviourRegistry, BindingError> {
+pub(crate) fn registry() -> Result<BehaviourRegistry, BindingError> {
     let mut registry = BehaviourRegistry::builtin();
     for (name, factory) in table().iter() {
         registry
@@ -53,7 +53,7 @@ pub fn registry() -> Result<BehaviourRegistry, BindingError> {
 
 /// Registers `factory` under `name` (module doc); refuses a bad or taken name.
 #[pyfunction]
-pub fn register_planner(name: &str, factory: Bound<'_, PyAny>) -> PyResult<()> {
+pub(crate) fn register_planner(name: &str, factory: Bound<'_, PyAny>) -> PyResult<()> {
     if !factory.is_callable() {
         return Err(BindingError::Input(format!(
             "planner {name:?}: the factory must be callable (a class whose instances have \
@@ -83,7 +83,7 @@ pub fn register_planner(name: &str, factory: Bound<'_, PyAny>) -> PyResult<()> {
 
 /// Removes the Python planner `name` (runs already started keep it).
 #[pyfunction]
-pub fn unregister_planner(name: &str) -> PyResult<()> {
+pub(crate) fn unregister_planner(name: &str) -> PyResult<()> {
     match table().remove(name) {
         Some(_) => Ok(()),
         None => Err(BindingError::Input(format!(
@@ -95,7 +95,7 @@ pub fn unregister_planner(name: &str) -> PyResult<()> {
 
 /// The names of the Python planners, sorted.
 #[pyfunction]
-pub fn python_planners() -> Vec<String> {
+pub(crate) fn python_planners() -> Vec<String> {
     table().keys().cloned().collect()
 }
 
@@ -129,7 +129,7 @@ fn python_factory(name: &str, factory: Arc<Py<PyAny>>) -> sim::registry::Behavio
 }
 
 /// One vehicle's Python planner (module doc).
-pub struct PythonPlanner {
+pub(crate) struct PythonPlanner {
     /// The registered name.
     name: String,
     /// The vehicle's name (`observation["ego_name"]`).

@@ -16,13 +16,13 @@ const MAX_SAMPLES: usize = 100_000;
 /// d the lateral offset from it (m, positive to the left of the direction of travel); a lane's
 /// frame continues straight before its start and past its end.
 #[pyclass(frozen, module = "mergesim._native", name = "Road")]
-pub struct Road {
+pub(crate) struct Road {
     lanes: Arc<LaneRoad>,
 }
 
 impl Road {
     /// A view of `lanes`.
-    pub fn new(lanes: Arc<LaneRoad>) -> Self {
+    pub(crate) fn new(lanes: Arc<LaneRoad>) -> Self {
         Self { lanes }
     }
 

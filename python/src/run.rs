@@ -13,7 +13,7 @@ use crate::source;
 /// and stops on Ctrl-C (`background`).
 #[pyfunction]
 #[pyo3(signature = (scenario, params_json = None, planner = None, seed = None))]
-pub fn run(
+pub(crate) fn run(
     py: Python<'_>,
     scenario: &str,
     params_json: Option<&str>,

@@ -7,7 +7,7 @@ use crate::errors::BindingError;
 
 /// Loads `source` as `merge_sim --scenario` does, or parses it as TOML text if it has a line
 /// break; `overrides_json` (a JSON object) is merged over the scenario's TOML tables first.
-pub fn load(source: &str, overrides_json: Option<&str>) -> Result<Scenario, BindingError> {
+pub(crate) fn load(source: &str, overrides_json: Option<&str>) -> Result<Scenario, BindingError> {
     let is_text = source.contains('\n');
     let Some(overrides_json) = overrides_json else {
         return if is_text {
@@ -43,7 +43,7 @@ pub fn load(source: &str, overrides_json: Option<&str>) -> Result<Scenario, Bind
 /// The TOML `text` with the JSON object `overrides_json` merged over it: tables are merged key by
 /// key, recursively; any other value (numbers, strings, arrays such as `vehicles`) replaces the
 /// scenario's.
-pub fn merge_overrides(
+pub(crate) fn merge_overrides(
     text: &str,
     origin: &str,
     overrides_json: &str,

@@ -16,7 +16,7 @@ use crate::errors::BindingError;
 /// CLI's message (file, line, field).
 #[pyfunction]
 #[pyo3(signature = (plan, out = None, threads = None))]
-pub fn study(
+pub(crate) fn study(
     py: Python<'_>,
     plan: &str,
     out: Option<&str>,

@@ -18,7 +18,7 @@ use crate::source;
 /// (`background`).
 #[pyfunction]
 #[pyo3(signature = (scenario, planners, runs, seed, params_json = None, threads = None))]
-pub fn sweep(
+pub(crate) fn sweep(
     py: Python<'_>,
     scenario: &str,
     planners: Vec<String>,

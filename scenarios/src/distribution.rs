@@ -56,7 +56,7 @@ fn exactly_two<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<[f64
 
 impl Distribution {
     /// Checks the parameters; the error says what is wrong (the caller adds the field name).
-    pub fn validate(&self) -> Result<(), String> {
+    pub(crate) fn validate(&self) -> Result<(), String> {
         match self {
             Distribution::Uniform([lo, hi]) => {
                 if !(lo.is_finite() && hi.is_finite()) {
@@ -89,14 +89,14 @@ impl Distribution {
     }
 
     /// The smallest and largest offset this distribution can produce.
-    pub fn offset_bounds(&self) -> [f64; 2] {
+    pub(crate) fn offset_bounds(&self) -> [f64; 2] {
         match self {
             Distribution::Uniform(bounds) => *bounds,
             Distribution::Normal(n) => n.clip,
         }
     }
 
-    /// One offset, from exactly one draw of `rng`. Always inside [`Self::offset_bounds`] for a
+    /// One offset, from exactly one draw of `rng`. Always inside `Self::offset_bounds` for a
     /// valid distribution.
     pub fn sample_offset(&self, rng: &mut SplitMix64) -> f64 {
         let u = rng.next_f64();

@@ -5,14 +5,22 @@
 //! a Monte-Carlo sweep draws instances from. Unknown keys are rejected; every number is
 //! range-checked, for the nominal values and for every instance the ranges allow; errors name
 //! the file, the line and the field.
+//!
+//! # Public API
+//! - [`Scenario`]: a scenario read from TOML ([`ScenarioSource`] says where from), validated,
+//!   with its errors [`ScenarioError`] (naming the file, line and field, [`source_location`]).
+//! - [`Randomisation`] and [`VehicleRandomisation`]: the ranges a sweep draws instances from,
+//!   as [`Distribution`]s ([`NormalOffset`]).
+//! - The built-in scenarios ([`builtin`]) and generated platoons ([`platoon`]); the scenario
+//!   module itself, [`scenario`], and the randomisation module, [`randomisation`].
 #![warn(missing_docs)]
 
 pub mod builtin;
-pub mod commonroad;
+pub(crate) mod commonroad;
 mod commonroad_toml;
-pub mod distribution;
+pub(crate) mod distribution;
 mod opendrive_source;
-pub mod oriented_box;
+pub(crate) mod oriented_box;
 pub mod platoon;
 pub mod randomisation;
 pub mod scenario;

@@ -5,7 +5,7 @@ use mergesim_types::lanes::Lane;
 
 /// A rectangle: centre, unit axis along its length, half length and half width (m).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct OrientedBox {
+pub(crate) struct OrientedBox {
     /// Centre (m).
     pub centre_m: [f64; 2],
     /// Unit vector along the length.
@@ -18,7 +18,13 @@ pub struct OrientedBox {
 
 impl OrientedBox {
     /// The body centred at (s, d) of `lane`, along the lane's heading at s.
-    pub fn on_lane(lane: &Lane, s_m: f64, d_m: f64, half_length_m: f64, half_width_m: f64) -> Self {
+    pub(crate) fn on_lane(
+        lane: &Lane,
+        s_m: f64,
+        d_m: f64,
+        half_length_m: f64,
+        half_width_m: f64,
+    ) -> Self {
         let (sin, cos) = lane.heading_rad(s_m).sin_cos();
         Self {
             centre_m: lane.point(s_m, d_m),
@@ -29,7 +35,7 @@ impl OrientedBox {
     }
 
     /// The four corners.
-    pub fn corners(&self) -> [[f64; 2]; 4] {
+    pub(crate) fn corners(&self) -> [[f64; 2]; 4] {
         let [c, a] = [self.centre_m, self.axis];
         let n = [-a[1], a[0]];
         let corner = |l: f64, w: f64| {
@@ -47,7 +53,7 @@ impl OrientedBox {
     }
 
     /// True if the two rectangles overlap (separating-axis test; touching counts as apart).
-    pub fn overlaps(&self, other: &Self) -> bool {
+    pub(crate) fn overlaps(&self, other: &Self) -> bool {
         let axes = [
             self.axis,
             [-self.axis[1], self.axis[0]],

@@ -94,14 +94,14 @@ const VEHICLE_FIELDS: [VehicleField; 5] = [
 
 impl VehicleRandomisation {
     /// True when nothing is randomised.
-    pub fn is_empty(&self) -> bool {
+    pub(crate) fn is_empty(&self) -> bool {
         VEHICLE_FIELDS.iter().all(|(_, get)| get(self).is_none())
     }
 }
 
 /// A randomisation entry that is wrong, with the path of its key (`randomise.vehicles.x.x_m`).
 #[derive(Clone, Debug, PartialEq)]
-pub struct RandomisationIssue {
+pub(crate) struct RandomisationIssue {
     /// Dotted TOML path of the entry.
     pub path: Vec<String>,
     /// What is wrong.
@@ -110,7 +110,7 @@ pub struct RandomisationIssue {
 
 /// How far one vehicle can be moved: offset bounds per target field, the resolved distributions.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct VehicleOffsetBounds {
+pub(crate) struct VehicleOffsetBounds {
     /// Offset bounds of `x_m`.
     pub x_m: [f64; 2],
     /// Offset bounds of `y_offset_m`.
@@ -179,7 +179,7 @@ impl Randomisation {
     }
 
     /// Checks every entry on its own: valid parameters, existing vehicle names.
-    pub fn check_entries(&self, vehicles: &[VehicleSpec]) -> Result<(), RandomisationIssue> {
+    pub(crate) fn check_entries(&self, vehicles: &[VehicleSpec]) -> Result<(), RandomisationIssue> {
         for (key, _, d) in self.sim_entries() {
             if let Some(d) = d {
                 d.validate().map_err(|message| RandomisationIssue {
@@ -221,7 +221,7 @@ impl Randomisation {
     }
 
     /// Offset bounds of every randomised value of vehicle `name`.
-    pub fn vehicle_bounds(&self, name: &str) -> VehicleOffsetBounds {
+    pub(crate) fn vehicle_bounds(&self, name: &str) -> VehicleOffsetBounds {
         let bounds = |field: usize| {
             self.vehicle_entry(name, field)
                 .map(|(d, _)| d.offset_bounds())

@@ -64,7 +64,7 @@ impl PartialEq for ScenarioSource {
 }
 
 /// The planner parameters of `set` with `overrides` (a `[sim.planner]` table) on top.
-pub fn planner_params_with_overrides(
+pub(crate) fn planner_params_with_overrides(
     set: ParameterSet,
     overrides: &toml::Table,
 ) -> Result<PlannerParams, String> {
@@ -298,7 +298,7 @@ impl Scenario {
         Ok(())
     }
 
-    /// Checks every value, nominal and randomised (see [`Scenario::check`]).
+    /// Checks every value, nominal and randomised (see `Scenario::check`).
     pub fn validate(&self, origin: &str) -> Result<(), ScenarioError> {
         self.check(origin, None)
     }
@@ -312,7 +312,7 @@ impl Scenario {
     ///    passing at both corners means every instance any seed can draw is valid.
     /// 4. Geometry over the whole box: a vehicle in the lower lane starts where that lane exists
     ///    (its front before `road.merge_end_x_m`), and no two vehicles can overlap at spawn.
-    pub fn check(&self, origin: &str, text: Option<&str>) -> Result<(), ScenarioError> {
+    pub(crate) fn check(&self, origin: &str, text: Option<&str>) -> Result<(), ScenarioError> {
         let at =
             |entry: Option<Vec<String>>| Line(text.zip(entry).and_then(|(t, p)| line_of(t, &p)));
         let sim_error = |e: SimError, prefix: &str, entry: Option<Vec<String>>| {
@@ -601,7 +601,7 @@ impl Scenario {
 
     /// The instance drawn with `seed` from the `[randomise]` ranges ("same scenario +
     /// same seed ⇒ same run"). Deterministic; the instance has no randomisation left, so it is
-    /// its own nominal scenario. For a scenario that passed [`Scenario::check`], every value of
+    /// its own nominal scenario. For a scenario that passed `Scenario::check`, every value of
     /// the instance is valid; otherwise `World::new` reports the bad value.
     pub fn instantiate(&self, seed: u64) -> Scenario {
         let (sim, vehicles) = self.randomise.draw(&self.sim, &self.vehicles, seed);

@@ -23,7 +23,7 @@ pub fn line_of(text: &str, path: &[String]) -> Option<usize> {
 }
 
 /// The 1-based line holding byte `offset` of `text`.
-pub fn line_at(text: &str, offset: usize) -> usize {
+pub(crate) fn line_at(text: &str, offset: usize) -> usize {
     let end = offset.min(text.len());
     text.as_bytes()[..end]
         .iter()

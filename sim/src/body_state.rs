@@ -37,18 +37,18 @@ pub struct BodyState {
 
 impl BodyState {
     /// Radius of the circle around the centre that contains the whole footprint (half diagonal).
-    pub fn bounding_radius_m(&self) -> f64 {
+    pub(crate) fn bounding_radius_m(&self) -> f64 {
         0.5 * self.length_m.hypot(self.width_m)
     }
 
     /// Speed over ground (m/s).
-    pub fn speed_mps(&self) -> f64 {
+    pub(crate) fn speed_mps(&self) -> f64 {
         self.vx_mps.hypot(self.vy_mps)
     }
 
     /// The first field that is not finite, or a dimension that is not strictly positive,
     /// as `(field name, value)`; `None` when the state is usable.
-    pub fn first_invalid_field(&self) -> Option<(&'static str, f64)> {
+    pub(crate) fn first_invalid_field(&self) -> Option<(&'static str, f64)> {
         let finite = [
             ("x_m", self.x_m),
             ("y_m", self.y_m),

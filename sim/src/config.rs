@@ -114,7 +114,7 @@ pub const SIM_BOUNDS: &[Bound] = &[
 
 /// Default of [`SimConfig::perception_range_m`]: long-range automotive radars reach 250 m
 /// (e.g. Bosch LRR4, Continental ARS 408); docs/parameters.md gives the criterion.
-pub const DEFAULT_PERCEPTION_RANGE_M: f64 = 250.0;
+pub(crate) const DEFAULT_PERCEPTION_RANGE_M: f64 = 250.0;
 
 /// Allowed ranges of a vehicle's own fields (`[[vehicles]]`); `x_m` must also lie on the road
 /// and the body must fit on it at spawn (checked by the scenario loader).

@@ -2,7 +2,7 @@
 
 use thiserror::Error;
 
-pub use mergesim_types::InvalidParameter;
+pub(crate) use mergesim_types::InvalidParameter;
 
 /// Everything that can stop a simulation. Never a panic.
 #[derive(Debug, Error)]
@@ -97,7 +97,7 @@ pub enum SimError {
 
 impl SimError {
     /// Shorthand for [`SimError::InvalidParameter`].
-    pub fn invalid(name: impl Into<String>, value: f64, reason: impl Into<String>) -> Self {
+    pub(crate) fn invalid(name: impl Into<String>, value: f64, reason: impl Into<String>) -> Self {
         Self::InvalidParameter(InvalidParameter::new(name, value, reason))
     }
 

@@ -130,7 +130,7 @@ pub enum SimEvent {
 
 impl SimEvent {
     /// The severity the event log and the recording give it.
-    pub fn level(&self) -> EventLevel {
+    pub(crate) fn level(&self) -> EventLevel {
         match self {
             Self::Collision { .. } | Self::EdgeContact { .. } => EventLevel::Error,
             Self::RecordedHandover { .. } | Self::GoalReached { .. } | Self::LaneChange { .. } => {

@@ -24,7 +24,7 @@ pub struct Interval {
 
 impl Interval {
     /// Whether `v` lies in the interval, ends included.
-    pub fn contains(&self, v: f64) -> bool {
+    pub(crate) fn contains(&self, v: f64) -> bool {
         self.start <= v && v <= self.end
     }
 
@@ -35,7 +35,7 @@ impl Interval {
 
     /// Whether the angle `a_rad` lies in the interval of angles: `a` shifted by a whole number
     /// of turns into `[start, start + 2π)` is at most `end` (so an interval crossing ±π works).
-    pub fn contains_angle(&self, a_rad: f64) -> bool {
+    pub(crate) fn contains_angle(&self, a_rad: f64) -> bool {
         let turn = std::f64::consts::TAU;
         if self.end - self.start >= turn {
             return true;
@@ -155,7 +155,7 @@ pub enum GoalPosition {
 
 impl GoalPosition {
     /// Whether the point meets the position condition.
-    pub fn contains(&self, p_m: [f64; 2], lanes: &LaneRoad) -> bool {
+    pub(crate) fn contains(&self, p_m: [f64; 2], lanes: &LaneRoad) -> bool {
         match self {
             GoalPosition::Shapes(shapes) => shapes.iter().any(|s| s.contains(p_m)),
             GoalPosition::Lanes(ids) => ids
@@ -175,7 +175,7 @@ pub struct GoalState {
     /// Position.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub position: Option<GoalPosition>,
-    /// Heading (rad), compared modulo a turn ([`Interval::contains_angle`]).
+    /// Heading (rad), compared modulo a turn (`Interval::contains_angle`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orientation_rad: Option<Interval>,
     /// Speed (m/s).
@@ -188,7 +188,7 @@ pub struct GoalState {
 
 /// The instant a goal is checked at: the vehicle's state.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GoalCheck {
+pub(crate) struct GoalCheck {
     /// Time since the start of the run (s).
     pub t_s: f64,
     /// Centre of gravity (m).
@@ -201,7 +201,7 @@ pub struct GoalCheck {
 
 impl GoalState {
     /// Whether the vehicle meets every condition of this state at `at`.
-    pub fn is_met(&self, at: &GoalCheck, lanes: &LaneRoad) -> bool {
+    pub(crate) fn is_met(&self, at: &GoalCheck, lanes: &LaneRoad) -> bool {
         self.time_s.is_none_or(|i| i.contains(at.t_s))
             && self.velocity_mps.is_none_or(|i| i.contains(at.speed_mps))
             && self
@@ -224,7 +224,7 @@ pub struct Goal {
 
 impl Goal {
     /// Whether the vehicle meets one of the goal states at `at`.
-    pub fn is_reached(&self, at: &GoalCheck, lanes: &LaneRoad) -> bool {
+    pub(crate) fn is_reached(&self, at: &GoalCheck, lanes: &LaneRoad) -> bool {
         self.states.iter().any(|s| s.is_met(at, lanes))
     }
 

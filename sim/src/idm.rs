@@ -10,9 +10,9 @@
 //! with v the speed, v₀ the desired speed, s the bumper-to-bumper gap to the leader and
 //! Δv = v − v_leader the approach rate. Without a leader the interaction term is dropped.
 //!
-//! Pure functions: no physics, no state. The world calls [`find_leader`] and
-//! [`idm_acceleration`] at each planning tick of an IDM vehicle and turns the acceleration into
-//! the speed profile of its lane-keeping path with [`speed_after_distance`].
+//! Pure functions: no physics, no state. The world calls `find_leader` and
+//! `idm_acceleration` at each planning tick of an IDM vehicle and turns the acceleration into
+//! the speed profile of its lane-keeping path with `speed_after_distance`.
 
 use serde::{Deserialize, Serialize};
 
@@ -71,7 +71,7 @@ pub const IDM_BOUNDS: &[Bound] = &[
 
 impl IdmParams {
     /// Checks every field against [`IDM_BOUNDS`]; the error names it (`idm.<field>`).
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         bounds::check_all(
             "idm",
             IDM_BOUNDS,
@@ -101,7 +101,7 @@ impl IdmParams {
 
 /// The vehicle ahead, as the follower sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Leader {
+pub(crate) struct Leader {
     /// Index of the leader in the slice given to [`find_leader`].
     pub index: usize,
     /// Bumper-to-bumper gap s (m); may be ≤ 0 when the bodies overlap longitudinally.
@@ -114,7 +114,7 @@ pub struct Leader {
 /// along the lane, `y_m` the offset d across it (on the straight merge road, x and y up to a
 /// constant).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RoadUser {
+pub(crate) struct RoadUser {
     /// Position of the centre (m).
     pub x_m: f64,
     /// Position of the centre (m).
@@ -134,7 +134,7 @@ pub fn desired_gap_m(params: &IdmParams, speed_mps: f64, approach_rate_mps: f64)
 
 /// IDM acceleration (m/s²), clamped to `[−max_decel_mps2, max_accel_mps2]`. Negative speeds
 /// count as 0; a non-positive gap gives full braking.
-pub fn idm_acceleration(
+pub(crate) fn idm_acceleration(
     params: &IdmParams,
     speed_mps: f64,
     desired_speed_mps: f64,
@@ -153,7 +153,7 @@ pub fn idm_acceleration(
 }
 
 /// The nearest vehicle ahead of `others[ego]` whose centre lies within the corridor.
-pub fn find_leader(params: &IdmParams, others: &[RoadUser], ego: usize) -> Option<Leader> {
+pub(crate) fn find_leader(params: &IdmParams, others: &[RoadUser], ego: usize) -> Option<Leader> {
     let me = others.get(ego)?;
     others
         .iter()
@@ -171,7 +171,7 @@ pub fn find_leader(params: &IdmParams, others: &[RoadUser], ego: usize) -> Optio
 
 /// Speed after `distance_m` at constant acceleration from `speed_mps` (v² = v₀² + 2·a·d),
 /// 0 once the vehicle would have stopped.
-pub fn speed_after_distance(speed_mps: f64, accel_mps2: f64, distance_m: f64) -> f64 {
+pub(crate) fn speed_after_distance(speed_mps: f64, accel_mps2: f64, distance_m: f64) -> f64 {
     (speed_mps.max(0.0).powi(2) + 2.0 * accel_mps2 * distance_m.max(0.0))
         .max(0.0)
         .sqrt()

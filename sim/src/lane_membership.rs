@@ -21,7 +21,7 @@ use mergesim_types::lanes::{LaneHit, LaneId, LaneRoad};
 pub const MERGE_ZONE_TAIL_M: f64 = 20.0;
 
 /// The lane holding `p_m`, keeping `previous` while the point is still in it (module doc).
-pub fn lane_of(lanes: &LaneRoad, previous: Option<LaneId>, p_m: [f64; 2]) -> LaneHit {
+pub(crate) fn lane_of(lanes: &LaneRoad, previous: Option<LaneId>, p_m: [f64; 2]) -> LaneHit {
     if let Some(lane) = previous.and_then(|id| lanes.lane(id)) {
         let frame = lane.project(p_m);
         if lane.contains_frame(frame) {
@@ -42,7 +42,7 @@ pub fn lane_of(lanes: &LaneRoad, previous: Option<LaneId>, p_m: [f64; 2]) -> Lan
 /// A change from lane `from` to lane `to`, as an event's words: `None` if it is none (same lane,
 /// or following a lane into its successor), else `Some("left")`, `Some("right")` or
 /// `Some("across")` (a lane that is not a same-direction neighbour).
-pub fn lane_change(lanes: &LaneRoad, from: LaneId, to: LaneId) -> Option<&'static str> {
+pub(crate) fn lane_change(lanes: &LaneRoad, from: LaneId, to: LaneId) -> Option<&'static str> {
     if from == to {
         return None;
     }
@@ -61,7 +61,12 @@ pub fn lane_change(lanes: &LaneRoad, from: LaneId, to: LaneId) -> Option<&'stati
 
 /// Signed distance of `p_m` to the bound of lane `from` facing lane `to` (m, in `from`'s frame;
 /// negative inside `from`): 0 on the divider crossed by a change `from` → `to`.
-pub fn beyond_divider_m(lanes: &LaneRoad, from: LaneId, to: LaneId, p_m: [f64; 2]) -> Option<f64> {
+pub(crate) fn beyond_divider_m(
+    lanes: &LaneRoad,
+    from: LaneId,
+    to: LaneId,
+    p_m: [f64; 2],
+) -> Option<f64> {
     let lane = lanes.lane(from)?;
     let fp = lane.project(p_m);
     if lane.left_neighbour() == Some(to) {
@@ -75,7 +80,7 @@ pub fn beyond_divider_m(lanes: &LaneRoad, from: LaneId, to: LaneId, p_m: [f64; 2
 
 /// The merge zone of a road (module doc).
 #[derive(Clone, Debug, PartialEq)]
-pub struct MergeZone {
+pub(crate) struct MergeZone {
     /// The lane positions are measured along (the one the ending lane merges into).
     pub along: LaneId,
     /// The zone as arc lengths along `along` (m).
@@ -90,7 +95,7 @@ pub struct MergeZone {
 impl MergeZone {
     /// The merge zone of the first lane (in description order) that ends closed beside a
     /// neighbour; `None` if the road has no such lane.
-    pub fn of(lanes: &LaneRoad) -> Option<Self> {
+    pub(crate) fn of(lanes: &LaneRoad) -> Option<Self> {
         let end = lanes.lane_ends().iter().find(|e| {
             e.closed
                 && lanes
@@ -124,7 +129,7 @@ impl MergeZone {
     }
 
     /// True if the point lies in the zone (its arc length along [`Self::along`] does).
-    pub fn contains(&self, lanes: &LaneRoad, p_m: [f64; 2]) -> bool {
+    pub(crate) fn contains(&self, lanes: &LaneRoad, p_m: [f64; 2]) -> bool {
         lanes.lane(self.along).is_some_and(|l| {
             let s = l.project(p_m).s_m;
             s >= self.s_m[0] && s <= self.s_m[1]

@@ -1,38 +1,54 @@
 //! The closed-loop merge simulation: the `World` (rapier physics, vehicles and their behaviours),
 //! the V2V bus, exact parry safety checks, the observers of a run (metrics, time series, Rerun
 //! recording), the simulator's own drivers and the registry of planners by name.
+//!
+//! # Public API
+//! - A run: [`World`] built from a [`SimConfig`] and its [`VehicleSpec`]s (checked by
+//!   [`validate_vehicles`]), run with [`RunOptions`] to a [`RunOutcome`] (with
+//!   [`TimeSeriesRow`]s, [`RecordedPose`]s, [`PlannerStats`]) or a [`SimError`].
+//! - The road: [`LaneRoadConfig`] ([`StartLane`]), a CommonRoad map [`CommonRoadRoad`], recorded
+//!   traffic ([`recorded_traffic`]), routes ([`route`]), goals ([`goal`]) and the drawing of a
+//!   road ([`road_drawing`]).
+//! - Who drives: each vehicle's [`Driver`]; planners by name in a [`BehaviourRegistry`] of
+//!   [`BehaviourFactory`]s (given a [`FactoryInput`]), with their parameter tables
+//!   ([`PlannerParameters`], [`ParamsTable`], [`ParamsError`]); the simulator's own drivers
+//!   ([`drivers`], [`idm`]).
+//! - Watching a run: a [`TickObserver`] sees [`VehicleView`]s, [`PlanView`]s and
+//!   [`SimEvent`]s; metrics ([`metrics`], [`paper_metrics`]), safety checks ([`safety`]), the
+//!   V2V bus ([`v2v`]), phase timings ([`profile`]) and Rerun recordings ([`recording`]).
+//! - Helpers: the seeded generator [`rng`] and the neighbour search [`spatial`].
 #![warn(missing_docs)]
 
-pub mod agent;
-pub mod body_state;
+pub(crate) mod agent;
+pub(crate) mod body_state;
 pub mod config;
 pub mod drivers;
-pub mod error;
-pub mod event;
+pub(crate) mod error;
+pub(crate) mod event;
 pub mod goal;
 pub mod idm;
-pub mod lane_membership;
+pub(crate) mod lane_membership;
 pub mod metrics;
-pub mod observer;
-pub mod outcome;
+pub(crate) mod observer;
+pub(crate) mod outcome;
 pub mod paper_metrics;
-pub mod planner_params;
-pub mod planner_stats;
+pub(crate) mod planner_params;
+pub(crate) mod planner_stats;
 pub mod profile;
-pub mod recorded_motion;
+pub(crate) mod recorded_motion;
 pub mod recorded_traffic;
 pub mod recording;
-pub mod recording_observer;
+pub(crate) mod recording_observer;
 pub mod registry;
 pub mod rng;
 pub mod road_config;
 pub mod road_drawing;
 pub mod route;
-pub mod run_log;
+pub(crate) mod run_log;
 pub mod safety;
 pub mod spatial;
 pub mod v2v;
-pub mod world;
+pub(crate) mod world;
 
 pub use config::{Driver, SimConfig, VehicleSpec, validate_vehicles};
 pub use error::SimError;
@@ -41,9 +57,7 @@ pub use event::SimEvent;
 /// the simulator.
 pub use mergesim_types::lanes;
 pub use mergesim_types::{
-    Behaviour, BehaviourError, Decision, DegradedMode, GridSpec, Lane, MergeRoad, Neighbour,
-    Observation, OptimiserReport, PathPoint, SharedLocalPath, TimedWaypoint, VehicleId,
-    VehicleShape, VehicleState,
+    Behaviour, BehaviourError, Decision, Lane, MergeRoad, Observation, PathPoint, VehicleId,
 };
 pub use observer::{PlanView, TickObserver, VehicleView};
 pub use outcome::{PlannerStats, RecordedPose, RunOutcome, TimeSeriesRow};

@@ -196,7 +196,7 @@ pub struct VehicleMetricsSummary {
     /// edge, any vehicle): over the samples logged before it, so a peak reached while or after
     /// the bodies touch does not enter. Absent (`None`) when the run had no contact: the
     /// whole-run figures are then the pre-contact ones. Set by the run's log
-    /// ([`crate::run_log::RunLog`]) with [`VehicleMetrics::summary`] at the first contact.
+    /// (`crate::run_log::RunLog`) with [`VehicleMetrics::summary`] at the first contact.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pre_contact: Option<Box<VehicleMetricsSummary>>,
 }

@@ -84,7 +84,7 @@ pub trait TickObserver: Send {
     }
 
     /// An event (collision, road-edge contact, fallback, lane change, near miss, …), typed;
-    /// `Display` gives its event-log line and [`SimEvent::level`] its severity.
+    /// `Display` gives its event-log line and `SimEvent::level` its severity.
     fn on_event(&mut self, _event: &SimEvent) -> Result<(), SimError> {
         Ok(())
     }

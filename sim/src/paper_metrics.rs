@@ -3,7 +3,7 @@
 //! its lane centre, and where and when it crosses the lane divider.
 //!
 //! Fed the same samples as [`crate::metrics::VehicleMetrics`] (one per logged instant), and read
-//! through the road of lanes ([`crate::lane_membership`]), so they mean the same on any road:
+//! through the road of lanes (`crate::lane_membership`), so they mean the same on any road:
 //! - **slowing onset**: the first sample more than `slowing_threshold_mps` below the vehicle's
 //!   target speed (tracker noise stays within a few cm/s);
 //! - **yaw-rate RMS inside / outside the merge zone**: √(∫ r² dt / T) over the intervals whose
@@ -11,7 +11,7 @@
 //!   the paper sees the winding between 167 and 272 m, i.e. in the merge section (160–260 m
 //!   here) and just after it, so the zone is the ending lane's taper and the 20 m after its end
 //!   (one second at 20 m/s, where a path that left the taper settles), measured along the lane
-//!   it merges into ([`MergeZone`]); on a road without an ending lane there is none (every
+//!   it merges into (`MergeZone`); on a road without an ending lane there is none (every
 //!   interval is outside, and `merge_zone_x_m` is `[0, 0]`);
 //! - **largest lateral offset from its lane centre**: the distance, in the lane's frame, from the
 //!   middle between the two bounds of the lane the vehicle is in (lane membership with
@@ -32,7 +32,7 @@ use crate::metrics::MetricsSample;
 pub use crate::lane_membership::MERGE_ZONE_TAIL_M;
 
 /// A speed drop below the target smaller than this is tracker noise, not slowing (m/s).
-pub const SLOWING_THRESHOLD_MPS: f64 = 0.1;
+pub(crate) const SLOWING_THRESHOLD_MPS: f64 = 0.1;
 
 /// Where and when a vehicle crossed the lane divider.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -68,7 +68,7 @@ pub struct PaperMetricsSummary {
 
 /// Running paper metrics of one vehicle.
 #[derive(Clone, Debug)]
-pub struct PaperMetrics {
+pub(crate) struct PaperMetrics {
     lanes: Arc<LaneRoad>,
     zone: Option<MergeZone>,
     target_speed_mps: f64,
@@ -87,7 +87,7 @@ pub struct PaperMetrics {
 impl PaperMetrics {
     /// Empty metrics of a vehicle with `target_speed_mps` on `lanes`; the merge zone is the
     /// ending lane's taper and [`MERGE_ZONE_TAIL_M`] after its end (module doc).
-    pub fn new(lanes: Arc<LaneRoad>, target_speed_mps: f64) -> Self {
+    pub(crate) fn new(lanes: Arc<LaneRoad>, target_speed_mps: f64) -> Self {
         Self {
             zone: MergeZone::of(&lanes),
             lanes,
@@ -106,7 +106,7 @@ impl PaperMetrics {
     }
 
     /// Adds the next sample (the caller checks finiteness and increasing time).
-    pub fn push(&mut self, s: &MetricsSample) {
+    pub(crate) fn push(&mut self, s: &MetricsSample) {
         if self.slowing_onset_s.is_none()
             && s.speed_mps < self.target_speed_mps - SLOWING_THRESHOLD_MPS
         {
@@ -159,7 +159,7 @@ impl PaperMetrics {
     }
 
     /// The figures so far.
-    pub fn summary(&self) -> PaperMetricsSummary {
+    pub(crate) fn summary(&self) -> PaperMetricsSummary {
         let rms = |integral: f64, time_s: f64| (time_s > 0.0).then(|| (integral / time_s).sqrt());
         PaperMetricsSummary {
             target_speed_mps: self.target_speed_mps,

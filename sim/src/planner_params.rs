@@ -21,7 +21,7 @@ use serde::de::DeserializeOwned;
 pub type ParamsTable = toml::Table;
 
 /// A planner's parsed and validated parameters, of the type it registered with.
-pub type ParsedParams = Arc<dyn Any + Send + Sync>;
+pub(crate) type ParsedParams = Arc<dyn Any + Send + Sync>;
 
 /// A planner's parameter type (`BehaviourRegistry::register_with_params`).
 pub trait PlannerParameters: DeserializeOwned + Default + Send + Sync + 'static {
@@ -52,7 +52,7 @@ impl ParamsError {
 }
 
 /// `top` over `base`, key by key (a key of `top` replaces the same key of `base` whole).
-pub fn overlay(base: Option<&ParamsTable>, top: Option<&ParamsTable>) -> ParamsTable {
+pub(crate) fn overlay(base: Option<&ParamsTable>, top: Option<&ParamsTable>) -> ParamsTable {
     let mut table = base.cloned().unwrap_or_default();
     for (key, value) in top.into_iter().flatten() {
         table.insert(key.clone(), value.clone());
@@ -62,7 +62,7 @@ pub fn overlay(base: Option<&ParamsTable>, top: Option<&ParamsTable>) -> ParamsT
 
 /// The key a serde error message names (`unknown field `x``, `missing field `x``, `… for key
 /// `x``), if any.
-pub fn key_in_message(message: &str, table: &ParamsTable) -> Option<String> {
+pub(crate) fn key_in_message(message: &str, table: &ParamsTable) -> Option<String> {
     for marker in ["unknown field `", "missing field `", "for key `"] {
         if let Some(rest) = message.split(marker).nth(1)
             && let Some(key) = rest.split('`').next()
@@ -79,7 +79,7 @@ pub fn key_in_message(message: &str, table: &ParamsTable) -> Option<String> {
 
 /// The key of `written` whose value `T` cannot read (`table` = `written` on top of any base):
 /// the first whose removal lets `table` be read (a wrong type names no key in serde's message).
-pub fn fault_key<T: DeserializeOwned>(
+pub(crate) fn fault_key<T: DeserializeOwned>(
     table: &ParamsTable,
     written: &ParamsTable,
 ) -> Option<String> {

@@ -10,7 +10,7 @@ use crate::outcome::PlannerStats;
 
 /// Counts the planners' decisions (module doc).
 #[derive(Clone, Debug, Default)]
-pub struct PlannerStatsObserver {
+pub(crate) struct PlannerStatsObserver {
     plan_times_us: Vec<f64>,
     fallbacks: u64,
     degraded_plans: u64,
@@ -21,7 +21,7 @@ pub struct PlannerStatsObserver {
 impl PlannerStatsObserver {
     /// The counters so far; the cycle times' median and 99th percentile are nearest-rank
     /// percentiles (0 without any cycle).
-    pub fn stats(&self) -> PlannerStats {
+    pub(crate) fn stats(&self) -> PlannerStats {
         let mut times = self.plan_times_us.clone();
         times.sort_by(f64::total_cmp);
         let percentile = |percent: f64| nearest_rank_percentile(&times, percent).unwrap_or(0.0);

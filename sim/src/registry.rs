@@ -104,7 +104,7 @@ pub struct FactoryInput<'a> {
 
 impl FactoryInput<'_> {
     /// The parameters as a `P` (None if there are none, or they are not a `P`).
-    pub fn params_as<P: 'static>(&self) -> Option<&P> {
+    pub(crate) fn params_as<P: 'static>(&self) -> Option<&P> {
         self.params.and_then(|p| p.downcast_ref::<P>())
     }
 }

@@ -31,7 +31,7 @@ pub struct LaneLabel {
 pub struct RoadDrawing {
     /// The drivable area's outer edges (closed lane ends included), solid.
     pub outer_edges: Vec<Vec<[f64; 2]>>,
-    /// The dividers between same-direction lanes, whole (see [`dashes`] to dash them).
+    /// The dividers between same-direction lanes, whole (see `dashes` to dash them).
     pub dividers: Vec<Vec<[f64; 2]>>,
     /// The closed ends of lanes that end, from the right bound to the left, those of a
     /// non-zero length (a taper's tip has none).
@@ -291,7 +291,7 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
 
 /// `polyline` cut into dashes `dash_m` long with gaps `gap_m` long, starting with a dash (a
 /// dash going round a vertex keeps it). A non-positive dash gives the polyline whole.
-pub fn dashes(polyline: &[[f64; 2]], dash_m: f64, gap_m: f64) -> Vec<Vec<[f64; 2]>> {
+pub(crate) fn dashes(polyline: &[[f64; 2]], dash_m: f64, gap_m: f64) -> Vec<Vec<[f64; 2]>> {
     if !(dash_m > 0.0 && gap_m >= 0.0 && (dash_m + gap_m).is_finite()) {
         return vec![polyline.to_vec()];
     }

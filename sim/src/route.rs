@@ -37,7 +37,7 @@ impl PartialOrd for Entry {
 
 /// The lanes reachable in one move from `lane`: its successors, then its same-direction left and
 /// right neighbours (a road of lanes links same-direction neighbours only).
-pub fn next_lanes(lanes: &LaneRoad, lane: LaneId) -> Vec<LaneId> {
+pub(crate) fn next_lanes(lanes: &LaneRoad, lane: LaneId) -> Vec<LaneId> {
     let Some(l) = lanes.lane(lane) else {
         return Vec::new();
     };

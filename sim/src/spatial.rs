@@ -12,14 +12,14 @@
 /// Whether the centres `a` and `b` are within `range_m` of each other (Euclidean; a distance
 /// equal to the range is within). The X test comes first so that the sweep's window (X only)
 /// is exactly the first half of the predicate.
-pub fn within_range(a: [f64; 2], b: [f64; 2], range_m: f64) -> bool {
+pub(crate) fn within_range(a: [f64; 2], b: [f64; 2], range_m: f64) -> bool {
     let dx = b[0] - a[0];
     dx.abs() <= range_m && dx.hypot(b[1] - a[1]) <= range_m
 }
 
 /// The vehicles' X, sorted once, for any number of window queries.
 #[derive(Clone, Debug, Default)]
-pub struct XSweep {
+pub(crate) struct XSweep {
     /// Indices sorted by (X, index).
     order: Vec<usize>,
     /// Rank of each index in `order`.
@@ -30,7 +30,7 @@ pub struct XSweep {
 
 impl XSweep {
     /// Sorts `xs` (finite values; a NaN sorts last and is never within a window).
-    pub fn new(xs: &[f64]) -> Self {
+    pub(crate) fn new(xs: &[f64]) -> Self {
         let mut order: Vec<usize> = (0..xs.len()).collect();
         order.sort_by(|&a, &b| xs[a].total_cmp(&xs[b]).then(a.cmp(&b)));
         let mut rank = vec![0; xs.len()];
@@ -45,7 +45,7 @@ impl XSweep {
     }
 
     /// Every index `j ≠ i` with |x_j − x_i| ≤ `window_m`, in increasing index order.
-    pub fn within_window(&self, i: usize, window_m: f64) -> Vec<usize> {
+    pub(crate) fn within_window(&self, i: usize, window_m: f64) -> Vec<usize> {
         let mut found = Vec::new();
         let Some(&r) = self.rank.get(i) else {
             return found;
@@ -68,7 +68,7 @@ impl XSweep {
     }
 
     /// Every pair (i, j), i < j, with |x_j − x_i| ≤ `window_m`, in increasing (i, j) order.
-    pub fn pairs_within_window(&self, window_m: f64) -> Vec<(usize, usize)> {
+    pub(crate) fn pairs_within_window(&self, window_m: f64) -> Vec<(usize, usize)> {
         let mut pairs = Vec::new();
         for (r, &i) in self.order.iter().enumerate() {
             let x = self.xs[i];
@@ -86,7 +86,7 @@ impl XSweep {
 
 /// For every vehicle, the others whose centres are [`within_range`] of it, in index order: the
 /// sweep.
-pub fn neighbours_within(positions: &[[f64; 2]], range_m: f64) -> Vec<Vec<usize>> {
+pub(crate) fn neighbours_within(positions: &[[f64; 2]], range_m: f64) -> Vec<Vec<usize>> {
     let xs: Vec<f64> = positions.iter().map(|p| p[0]).collect();
     let sweep = XSweep::new(&xs);
     (0..positions.len())
@@ -100,7 +100,7 @@ pub fn neighbours_within(positions: &[[f64; 2]], range_m: f64) -> Vec<Vec<usize>
         .collect()
 }
 
-/// [`neighbours_within`] by looking at every pair (the reference of the tests).
+/// `neighbours_within` by looking at every pair (the reference of the tests).
 pub fn neighbours_within_brute_force(positions: &[[f64; 2]], range_m: f64) -> Vec<Vec<usize>> {
     (0..positions.len())
         .map(|i| {

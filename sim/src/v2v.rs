@@ -51,7 +51,7 @@ pub struct V2vParams {
 
 /// Default of [`V2vParams::range_m`]: DSRC (IEEE 802.11p) reaches about 300 m (NHTSA, *V2V
 /// Communications: Readiness of V2V Technology for Application*, 2014).
-pub const DEFAULT_V2V_RANGE_M: f64 = 300.0;
+pub(crate) const DEFAULT_V2V_RANGE_M: f64 = 300.0;
 
 impl Default for V2vParams {
     fn default() -> Self {
@@ -80,7 +80,7 @@ pub const V2V_BOUNDS: &[Bound] = &[
 
 impl V2vParams {
     /// Checks every field against [`V2V_BOUNDS`]; the error names it.
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         bounds::check_all(
             "v2v",
             V2V_BOUNDS,
@@ -122,7 +122,7 @@ pub struct V2vStats {
 
 /// The bus. Everything is kept in ordered maps and vectors so delivery order is deterministic.
 #[derive(Clone, Debug)]
-pub struct V2vBus {
+pub(crate) struct V2vBus {
     params: V2vParams,
     rng: SplitMix64,
     /// Jitter and duplicates (a stream of its own: see the module doc).
@@ -138,7 +138,7 @@ pub struct V2vBus {
 
 impl V2vBus {
     /// A bus with its own random stream (drops) seeded by `seed`.
-    pub fn new(params: V2vParams, seed: u64) -> Result<Self, SimError> {
+    pub(crate) fn new(params: V2vParams, seed: u64) -> Result<Self, SimError> {
         params.validate()?;
         Ok(Self {
             params,
@@ -158,12 +158,12 @@ impl V2vBus {
     }
 
     /// What happened so far.
-    pub fn stats(&self) -> V2vStats {
+    pub(crate) fn stats(&self) -> V2vStats {
         self.stats
     }
 
     /// Whether `sender` may broadcast at `t_s` given the broadcast period.
-    pub fn may_broadcast(&self, sender: VehicleId, t_s: f64) -> bool {
+    pub(crate) fn may_broadcast(&self, sender: VehicleId, t_s: f64) -> bool {
         match self.last_broadcast_s.get(&sender) {
             None => true,
             // A small tolerance so a period equal to the planner period is not skipped by rounding.
@@ -173,7 +173,7 @@ impl V2vBus {
 
     /// Broadcasts `message` at `t_s` to `receivers` (the sender itself is skipped). Returns false
     /// when the broadcast period has not elapsed (nothing sent).
-    pub fn broadcast(
+    pub(crate) fn broadcast(
         &mut self,
         t_s: f64,
         message: &SharedLocalPath,
@@ -223,7 +223,7 @@ impl V2vBus {
 
     /// Delivers every message whose delivery time has come (in send order). Costs nothing
     /// until the earliest message in flight is due.
-    pub fn deliver(&mut self, t_s: f64) {
+    pub(crate) fn deliver(&mut self, t_s: f64) {
         if self.next_due_s > t_s + 1e-12 {
             return;
         }
@@ -252,7 +252,7 @@ impl V2vBus {
     /// stale path stays stale, and a message older than a forgotten one that arrives later is
     /// stale as well ([`Self::fresh_paths`] never returns either). It keeps each inbox as small
     /// as the set of senders heard recently, rather than every sender ever heard.
-    pub fn forget_stale(&mut self, t_s: f64) {
+    pub(crate) fn forget_stale(&mut self, t_s: f64) {
         let stale_after_s = self.params.stale_after_s;
         for by_sender in self.inbox.values_mut() {
             by_sender.retain(|_, p| is_fresh(p.stamp_s, t_s, stale_after_s));
@@ -260,7 +260,7 @@ impl V2vBus {
     }
 
     /// The fresh paths `receiver` holds at `t_s`, ordered by sender id.
-    pub fn fresh_paths(&self, receiver: VehicleId, t_s: f64) -> Vec<SharedLocalPath> {
+    pub(crate) fn fresh_paths(&self, receiver: VehicleId, t_s: f64) -> Vec<SharedLocalPath> {
         self.inbox
             .get(&receiver)
             .map(|by_sender| {

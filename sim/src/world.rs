@@ -37,8 +37,6 @@ mod outputs;
 mod planning;
 mod recorded;
 
-pub use recorded::Handover;
-
 /// Options of one run that are not part of the scenario.
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {

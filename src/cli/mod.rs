@@ -19,7 +19,7 @@
 //! SIGINT / SIGTERM (a sweep first writes what finished).
 //!
 //! The command line only parses its arguments (`args.rs`), calls the library
-//! ([`crate::experiment::run_instance`], [`crate::sweep`], [`crate::grid`], [`crate::study`], …)
+//! ([`crate::experiment::run_instance`], [`crate::sweep`], `crate::grid`, [`crate::study`], …)
 //! and prints or writes what it returns. Each command is one pipeline: load, check the outputs,
 //! simulate (with its observers), write.
 

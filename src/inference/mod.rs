@@ -5,9 +5,9 @@
 //! - [`distributions`]: Student's t, the standard normal and the binomial (CDFs and quantiles,
 //!   on the regularised incomplete beta function);
 //! - [`paired_t`](mod@paired_t): the paired t-interval and t-test on per-instance differences (Student 1908);
-//! - [`wilcoxon`]: the Wilcoxon signed-rank test (Wilcoxon 1945), as `scipy.stats.wilcoxon`;
-//! - [`mcnemar`]: the exact McNemar test on a paired 2×2 table (McNemar 1947);
-//! - [`paired_proportions`]: Newcombe's (1998) method 10 interval for the difference of paired
+//! - `wilcoxon`: the Wilcoxon signed-rank test (Wilcoxon 1945), as `scipy.stats.wilcoxon`;
+//! - `mcnemar`: the exact McNemar test on a paired 2×2 table (McNemar 1947);
+//! - `paired_proportions`: Newcombe's (1998) method 10 interval for the difference of paired
 //!   proportions;
 //! - [`holm`](mod@holm): Holm's (1979) step-down adjustment of a family of p-values.
 //!
@@ -19,10 +19,10 @@
 
 pub mod distributions;
 pub mod holm;
-pub mod mcnemar;
-pub mod paired_proportions;
+pub(crate) mod mcnemar;
+pub(crate) mod paired_proportions;
 pub mod paired_t;
-pub mod wilcoxon;
+pub(crate) mod wilcoxon;
 
 pub use holm::holm;
 pub use mcnemar::{Discordance, mcnemar_exact};

@@ -27,7 +27,7 @@ pub struct PairedProportionDifference {
     pub ci: [f64; 2],
     /// The interval's confidence level, in (0, 1).
     pub confidence: f64,
-    /// How the interval was computed ([`NEWCOMBE_METHOD_10`]).
+    /// How the interval was computed (`NEWCOMBE_METHOD_10`).
     pub method: &'static str,
 }
 

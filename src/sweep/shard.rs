@@ -53,7 +53,7 @@ impl Shard {
     pub const WHOLE: Shard = Shard { index: 0, count: 1 };
 
     /// Shard `index` of `count`; `source_name` names the origin in errors.
-    pub fn new(index: u64, count: u64, source_name: &str) -> Result<Self, ShardError> {
+    pub(crate) fn new(index: u64, count: u64, source_name: &str) -> Result<Self, ShardError> {
         if count == 0 || index >= count {
             return Err(ShardError::Invalid {
                 source_name: source_name.to_string(),

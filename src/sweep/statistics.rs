@@ -41,7 +41,7 @@ pub fn wilson_interval(successes: u64, n: u64, z: f64) -> Option<[f64; 2]> {
 
 /// The project's one percentile (`mergesim_types::percentile`), here beside the other
 /// statistics of a sweep.
-pub use mergesim_types::percentile::nearest_rank_percentile;
+pub(crate) use mergesim_types::percentile::nearest_rank_percentile;
 
 /// Arithmetic mean, summed in the given order. `None` for no values.
 pub fn mean(values: &[f64]) -> Option<f64> {

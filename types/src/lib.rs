@@ -5,18 +5,31 @@
 //!
 //! No physics, no optimiser, no logging: the planner, the vehicle model and the simulator all
 //! speak these types, and depend on nothing else to do so.
+//!
+//! # Public API
+//! - A vehicle: [`VehicleState`], [`VehicleShape`], [`VehicleId`], and a neighbour as another
+//!   vehicle sees it, [`Neighbour`].
+//! - Paths: [`PathPoint`], [`TimedWaypoint`] and the V2V message [`SharedLocalPath`].
+//! - The merge road: [`MergeRoad`] and its [`Lane`]s; roads made of lanes: [`lanes`]
+//!   ([`lanes::LaneRoad`] built from a [`lanes::LaneRoadSpec`]).
+//! - The interface every driver implements: [`Behaviour`], fed an [`Observation`], answering a
+//!   [`Decision`] (with [`DegradedMode`], [`OptimiserReport`], [`BehaviourError`]).
+//! - A sampling grid [`GridSpec`] (at most [`MAX_GRID_CELLS`] cells), a parameter's range
+//!   [`Bound`] ([`bounds`]) and the error for a value out of range, [`InvalidParameter`].
+//! - Helpers: [`files::read_regular_text`], [`percentile::nearest_rank_percentile`] and the
+//!   merge road's limits in [`road`].
 #![warn(missing_docs)]
 
-pub mod behaviour;
+pub(crate) mod behaviour;
 pub mod bounds;
-pub mod error;
+pub(crate) mod error;
 pub mod files;
-pub mod grid;
+pub(crate) mod grid;
 pub mod lanes;
-pub mod path;
+pub(crate) mod path;
 pub mod percentile;
 pub mod road;
-pub mod vehicle;
+pub(crate) mod vehicle;
 
 pub use behaviour::{
     Behaviour, BehaviourError, Decision, DegradedMode, FallbackReason, Observation,

@@ -8,19 +8,19 @@
 use rapier3d::prelude::{Group, InteractionGroups, InteractionTestMode};
 
 /// Layer of the road surface / flat pad.
-pub const ROAD_SURFACE: Group = Group::GROUP_1;
+pub(crate) const ROAD_SURFACE: Group = Group::GROUP_1;
 /// Layer of the road-edge barriers.
-pub const ROAD_EDGE: Group = Group::GROUP_2;
+pub(crate) const ROAD_EDGE: Group = Group::GROUP_2;
 /// Layer of the vehicle chassis.
-pub const VEHICLE: Group = Group::GROUP_3;
+pub(crate) const VEHICLE: Group = Group::GROUP_3;
 
 /// Groups of a road-surface collider.
-pub const fn road_surface() -> InteractionGroups {
+pub(crate) const fn road_surface() -> InteractionGroups {
     InteractionGroups::new(ROAD_SURFACE, VEHICLE, InteractionTestMode::And)
 }
 
 /// Groups of a road-edge barrier collider.
-pub const fn road_edge() -> InteractionGroups {
+pub(crate) const fn road_edge() -> InteractionGroups {
     InteractionGroups::new(ROAD_EDGE, VEHICLE, InteractionTestMode::And)
 }
 
@@ -34,6 +34,6 @@ pub const fn vehicle() -> InteractionGroups {
 }
 
 /// Query groups of a wheel ray: it sees the road surface only.
-pub const fn wheel_ray() -> InteractionGroups {
+pub(crate) const fn wheel_ray() -> InteractionGroups {
     InteractionGroups::new(VEHICLE, ROAD_SURFACE, InteractionTestMode::And)
 }

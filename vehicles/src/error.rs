@@ -2,7 +2,7 @@
 
 use thiserror::Error;
 
-pub use mergesim_types::InvalidParameter;
+pub(crate) use mergesim_types::InvalidParameter;
 
 /// Everything that can go wrong when building or driving a vehicle. Never a panic.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -33,7 +33,7 @@ pub enum VehicleError {
 
 impl VehicleError {
     /// Shorthand for [`VehicleError::InvalidParameter`].
-    pub fn invalid(name: impl Into<String>, value: f64, reason: impl Into<String>) -> Self {
+    pub(crate) fn invalid(name: impl Into<String>, value: f64, reason: impl Into<String>) -> Self {
         Self::InvalidParameter(InvalidParameter::new(name, value, reason))
     }
 

@@ -12,23 +12,35 @@
 //! vehicle.apply_forces(&mut world, mu);   // every vehicle, in id order
 //! world.step();
 //! ```
+//!
+//! # Public API
+//! - The physics scene: [`PhysicsWorld`] (gravity [`GRAVITY_MPS2`]) with the road's walls,
+//!   [`RoadColliders`] from [`RoadColliderParams`] ([`road_collider`], [`collision_groups`]).
+//! - A car: [`Vehicle`] from [`VehicleParams`] and [`TireParams`] (the presets
+//!   [`PRESET_NAMES`]), driven by [`Controls`] ([`WHEEL_NAMES`]), read back as [`Kinematics`],
+//!   [`BodyBox`] and [`WheelTelemetry`]; a body moved kinematically, [`KinematicBox`].
+//! - The path tracker: [`Tracker`] from [`TrackerParams`], with its [`SpeedController`].
+//! - Validation: [`run_maneuver`] of a [`ManeuverConfig`] ([`ManeuverKind`]) gives a
+//!   [`ManeuverReport`], compared with the linear single-track model [`LinearSingleTrack`]
+//!   ([`linear_yaw_rate_radps`]).
+//! - Errors: [`VehicleError`].
 #![warn(missing_docs)]
 
 pub mod collision_groups;
-pub mod controls;
-pub mod error;
-pub mod kinematic_body;
-pub mod kinematics;
+pub(crate) mod controls;
+pub(crate) mod error;
+pub(crate) mod kinematic_body;
+pub(crate) mod kinematics;
 pub mod maneuver;
-pub mod params;
-pub mod physics_world;
-pub mod presets;
+pub(crate) mod params;
+pub(crate) mod physics_world;
+pub(crate) mod presets;
 pub mod road_collider;
-pub mod single_track;
-pub mod tire;
+pub(crate) mod single_track;
+pub(crate) mod tire;
 pub mod tracker;
-pub mod vehicle;
-pub mod wheel;
+pub(crate) mod vehicle;
+pub(crate) mod wheel;
 
 pub use controls::{Controls, WHEEL_NAMES};
 pub use error::VehicleError;

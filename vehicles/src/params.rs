@@ -77,7 +77,7 @@ pub struct TireParams {
     pub relaxation_length_lat_m: f64,
     /// Speed floor in the slip-ratio denominator (m/s): κ = (ω r − v_x) / max(|v_x|, this).
     /// Raised automatically to keep the locked-wheel friction damper stable at large steps
-    /// (see [`crate::tire::slip_speed_floor_mps`]).
+    /// (see `crate::tire::slip_speed_floor_mps`).
     pub low_speed_floor_mps: f64,
     /// Below this forward speed a lateral damper fades in (m/s); PAC2002's `VXLOW` idea.
     pub low_speed_fade_mps: f64,
@@ -121,7 +121,7 @@ impl Default for TireParams {
 
 impl TireParams {
     /// Checks every coefficient; the error names the field and its value.
-    pub fn validate(&self) -> Result<(), VehicleError> {
+    pub(crate) fn validate(&self) -> Result<(), VehicleError> {
         let all = [
             ("p_cx1", self.p_cx1),
             ("p_dx1", self.p_dx1),
@@ -216,7 +216,7 @@ impl TireParams {
 
 /// Physical parameters of a four-wheeled car (world frame: X forward, Y left, Z up).
 ///
-/// Defaults: CommonRoad vehicle 2, BMW 320i ([`crate::presets::bmw_320i`]).
+/// Defaults: CommonRoad vehicle 2, BMW 320i (`crate::presets::bmw_320i`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct VehicleParams {
@@ -292,12 +292,12 @@ impl VehicleParams {
     }
 
     /// Static normal load on one front wheel, m·g·l_r / (2 L) (N).
-    pub fn static_load_front_n(&self, gravity_mps2: f64) -> f64 {
+    pub(crate) fn static_load_front_n(&self, gravity_mps2: f64) -> f64 {
         self.mass_kg * gravity_mps2 * self.cog_to_rear_axle_m / (2.0 * self.wheelbase_m())
     }
 
     /// Static normal load on one rear wheel, m·g·l_f / (2 L) (N).
-    pub fn static_load_rear_n(&self, gravity_mps2: f64) -> f64 {
+    pub(crate) fn static_load_rear_n(&self, gravity_mps2: f64) -> f64 {
         self.mass_kg * gravity_mps2 * self.cog_to_front_axle_m / (2.0 * self.wheelbase_m())
     }
 

@@ -14,7 +14,7 @@ use crate::road_collider::{RoadColliderParams, RoadColliders, build_lane_road, l
 pub const GRAVITY_MPS2: f64 = 9.81;
 
 /// Smallest and largest accepted physics step (s).
-pub const DT_RANGE_S: (f64, f64) = (1e-4, 0.02);
+pub(crate) const DT_RANGE_S: (f64, f64) = (1e-4, 0.02);
 
 /// Thickness of the flat pad (m); its top face is the plane z = 0.
 const FLAT_GROUND_THICKNESS_M: f64 = 1.0;
@@ -29,7 +29,7 @@ pub const FALLBACK_GROUND_HALF_EXTENT_M: f64 = 1000.0;
 /// Rapier's `f32` resolves 0.5 mm at 6 km but 61 µm below 1 km. Every position handed to
 /// Rapier is therefore taken relative to a *local origin* (m, in the road's coordinates):
 /// (0, 0) until [`add_lane_road`](Self::add_lane_road) sets it from the road
-/// ([`local_origin_for`]: (0, 0) for a road centred within 2048 m of the origin, else the road
+/// (`local_origin_for`: (0, 0) for a road centred within 2048 m of the origin, else the road
 /// bounds' centre snapped to 1024 m). The vehicles convert at their boundary ([`crate::Vehicle::spawn`],
 /// [`crate::Vehicle::kinematics`], [`crate::Vehicle::wheel_telemetry`]): everything they take
 /// and give is in the road's own coordinates. Only what is read straight from Rapier
@@ -50,7 +50,7 @@ pub struct PhysicsWorld {
 
 impl PhysicsWorld {
     /// A world stepping `dt_s` seconds per [`step`](Self::step); `dt_s` must lie in
-    /// [`DT_RANGE_S`].
+    /// `DT_RANGE_S`.
     pub fn new(dt_s: f64) -> Result<Self, VehicleError> {
         if !dt_s.is_finite() || dt_s < DT_RANGE_S.0 || dt_s > DT_RANGE_S.1 {
             return Err(VehicleError::invalid(
@@ -98,7 +98,7 @@ impl PhysicsWorld {
     }
 
     /// Adds a square flat pad centred on the origin, top face at z = 0 (for maneuvers). A
-    /// non-finite or non-positive size falls back to [`FALLBACK_GROUND_HALF_EXTENT_M`]; use
+    /// non-finite or non-positive size falls back to `FALLBACK_GROUND_HALF_EXTENT_M`; use
     /// [`try_add_flat_ground`](Self::try_add_flat_ground) to get an error instead.
     pub fn add_flat_ground(&mut self, half_extent_m: f64) {
         let half = if half_extent_m.is_finite() && half_extent_m > 0.0 {
@@ -175,13 +175,13 @@ impl PhysicsWorld {
     ///
     /// If no rigid body and no road surface has been added yet and the origin was not set with
     /// [`set_local_origin_m`](Self::set_local_origin_m), this first sets the local origin from
-    /// the road ([`local_origin_for`]); otherwise the road is built around the origin in use.
+    /// the road (`local_origin_for`); otherwise the road is built around the origin in use.
     pub fn add_lane_road(&mut self, lanes: &mergesim_types::lanes::LaneRoad) -> RoadColliders {
         self.add_lane_road_with(lanes, &RoadColliderParams::default())
     }
 
     /// [`add_lane_road`](Self::add_lane_road) with explicit barrier / surface dimensions.
-    pub fn add_lane_road_with(
+    pub(crate) fn add_lane_road_with(
         &mut self,
         lanes: &mergesim_types::lanes::LaneRoad,
         params: &RoadColliderParams,
@@ -202,7 +202,7 @@ impl PhysicsWorld {
     /// [`add_lane_road`](Self::add_lane_road): a collider inserted through
     /// [`rapier_mut`](Self::rapier_mut) is solid for the chassis (if its groups say so) but
     /// invisible to the wheels.
-    pub fn add_road_surface(&mut self, collider: ColliderBuilder) -> ColliderHandle {
+    pub(crate) fn add_road_surface(&mut self, collider: ColliderBuilder) -> ColliderHandle {
         let collider = collider
             .collision_groups(collision_groups::road_surface())
             .build();
@@ -230,7 +230,7 @@ impl PhysicsWorld {
     }
 
     /// The rigid bodies, mutable (e.g. to add forces of your own).
-    pub fn bodies_mut(&mut self) -> &mut RigidBodySet {
+    pub(crate) fn bodies_mut(&mut self) -> &mut RigidBodySet {
         &mut self.world.bodies
     }
 
@@ -251,7 +251,7 @@ impl PhysicsWorld {
 
     /// The wrapped rapier world, mutable. Changing `integration_parameters.dt` desynchronises
     /// [`dt_s`](Self::dt_s); don't.
-    pub fn rapier_mut(&mut self) -> &mut RapierWorld {
+    pub(crate) fn rapier_mut(&mut self) -> &mut RapierWorld {
         &mut self.world
     }
 

@@ -30,7 +30,7 @@ const COMMONROAD_MAX_ACCEL_MPS2: f64 = 11.5;
 const COLLIDER_GROUND_CLEARANCE_M: f64 = 0.2;
 
 /// BMW 320i: CommonRoad vehicle 2 (`parameters_vehicle2.yaml`). Rear-wheel drive.
-pub fn bmw_320i() -> VehicleParams {
+pub(crate) fn bmw_320i() -> VehicleParams {
     let mass_kg = 1093.2952334674046;
     let wheel_radius_m = 0.344;
     VehicleParams {
@@ -66,7 +66,7 @@ pub fn bmw_320i() -> VehicleParams {
 }
 
 /// Ford Escort: CommonRoad vehicle 1 (`parameters_vehicle1.yaml`). Front-wheel drive.
-pub fn ford_escort() -> VehicleParams {
+pub(crate) fn ford_escort() -> VehicleParams {
     let mass_kg = 1225.8878467253344;
     let wheel_radius_m = 0.344;
     VehicleParams {
@@ -102,7 +102,7 @@ pub fn ford_escort() -> VehicleParams {
 }
 
 /// VW Vanagon: CommonRoad vehicle 3 (`parameters_vehicle3.yaml`). Rear-wheel drive.
-pub fn vw_vanagon() -> VehicleParams {
+pub(crate) fn vw_vanagon() -> VehicleParams {
     let mass_kg = 1478.8979637767998;
     let wheel_radius_m = 0.344;
     VehicleParams {

@@ -22,13 +22,13 @@ use serde::{Deserialize, Serialize};
 use crate::collision_groups;
 
 /// Grid the local origin snaps to (m): a power of two, so the shift is exact.
-pub const LOCAL_ORIGIN_GRID_M: f64 = 1024.0;
+pub(crate) const LOCAL_ORIGIN_GRID_M: f64 = 1024.0;
 
 /// A road whose bounds' centre lies within this of the world origin in both coordinates is
 /// not moved (m): every built-in road (the 3050 m platoon road's centre is at x = 1475 m)
 /// keeps its Rapier coordinates, and so its results, bit for bit. Beyond it (a map kilometres
 /// away) the f32 resolution (0.49 mm at 4 to 8 km) is worth the shift.
-pub const LOCAL_ORIGIN_KEEP_M: f64 = 2048.0;
+pub(crate) const LOCAL_ORIGIN_KEEP_M: f64 = 2048.0;
 
 /// How far beside an edge piece the drivable area is probed to tell the road's side (m): more
 /// than the lanes' sliver tolerance ([`mergesim_types::lanes::SLIVER_M`], 5 mm).
@@ -110,7 +110,7 @@ pub fn road_side_of(lanes: &LaneRoad, a: [f64; 2], b: [f64; 2]) -> Option<RoadSi
 }
 
 /// The bounding box of every lane's bounds, `[min, max]` in the road's coordinates (m).
-pub fn road_bounds_m(lanes: &LaneRoad) -> [[f64; 2]; 2] {
+pub(crate) fn road_bounds_m(lanes: &LaneRoad) -> [[f64; 2]; 2] {
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
     for lane in lanes.lanes() {
@@ -131,7 +131,7 @@ pub fn road_bounds_m(lanes: &LaneRoad) -> [[f64; 2]; 2] {
 /// rounded to the nearest multiple of [`LOCAL_ORIGIN_GRID_M`] in each coordinate: a road
 /// 5.9 km away is shifted so that its Rapier coordinates stay within half its extent + 512 m
 /// of the local origin.
-pub fn local_origin_for(lanes: &LaneRoad) -> [f64; 2] {
+pub(crate) fn local_origin_for(lanes: &LaneRoad) -> [f64; 2] {
     let [lo, hi] = road_bounds_m(lanes);
     let centre = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
     if !centre.iter().all(|c| c.is_finite())

@@ -39,7 +39,7 @@ use crate::params::TireParams;
 
 /// Forces of one tyre in its ground frame and the slope used by the implicit wheel-spin step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct TireForces {
+pub(crate) struct TireForces {
     /// Longitudinal force (N), positive forward.
     pub fx_n: f64,
     /// Lateral force (N), positive to the left.
@@ -51,7 +51,7 @@ pub struct TireForces {
 
 /// μ-dependent constants of the tyre curves, computed once per friction coefficient.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TireCurves {
+pub(crate) struct TireCurves {
     /// Road friction coefficient μ the curves were built for.
     pub mu: f64,
     b_x: f64,
@@ -99,7 +99,7 @@ fn peak_argument(c: f64, e: f64) -> f64 {
 
 impl TireCurves {
     /// Builds the curves for friction coefficient `mu` (> 0, checked by the caller).
-    pub fn new(p: &TireParams, mu: f64) -> Self {
+    pub(crate) fn new(p: &TireParams, mu: f64) -> Self {
         let b_x = p.p_kx1 / (p.p_cx1 * mu);
         let b_y = p.p_ky1 / (p.p_cy1 * mu);
         let peak_x = peak_argument(p.p_cx1, p.p_ex1);
@@ -115,7 +115,7 @@ impl TireCurves {
 
     /// Pure longitudinal force F_x0(κ) and its slope ∂F_x0/∂κ (N).
     #[inline]
-    pub fn pure_longitudinal(&self, p: &TireParams, fz_n: f64, kappa: f64) -> (f64, f64) {
+    pub(crate) fn pure_longitudinal(&self, p: &TireParams, fz_n: f64, kappa: f64) -> (f64, f64) {
         let d = self.mu * fz_n;
         let (f, df_dx) = magic_formula(self.b_x * (kappa + p.p_hx1), p.p_cx1, d, p.p_ex1);
         (f + p.p_vx1 * fz_n, df_dx * self.b_x)
@@ -123,14 +123,14 @@ impl TireCurves {
 
     /// Pure lateral force F_y0(α) (N).
     #[inline]
-    pub fn pure_lateral(&self, p: &TireParams, fz_n: f64, alpha_rad: f64) -> f64 {
+    pub(crate) fn pure_lateral(&self, p: &TireParams, fz_n: f64, alpha_rad: f64) -> f64 {
         let d = self.mu * fz_n;
         magic_formula(self.b_y * alpha_rad, p.p_cy1, d, p.p_ey1).0
     }
 
     /// Weighting G_xα(κ, α) of the longitudinal force under combined slip.
     #[inline]
-    pub fn g_x_alpha(&self, p: &TireParams, kappa: f64, alpha_rad: f64) -> f64 {
+    pub(crate) fn g_x_alpha(&self, p: &TireParams, kappa: f64, alpha_rad: f64) -> f64 {
         // cos(atan(z)) = 1 / sqrt(1 + z²)
         let rk = p.r_bx2 * kappa;
         let b = p.r_bx1 / (1.0 + rk * rk).sqrt();
@@ -141,7 +141,7 @@ impl TireCurves {
 
     /// Weighting G_yκ(κ, α) of the lateral force under combined slip.
     #[inline]
-    pub fn g_y_kappa(&self, p: &TireParams, kappa: f64, alpha_rad: f64) -> f64 {
+    pub(crate) fn g_y_kappa(&self, p: &TireParams, kappa: f64, alpha_rad: f64) -> f64 {
         let ra = p.r_by2 * (alpha_rad - p.r_by3);
         let b = p.r_by1 / (1.0 + ra * ra).sqrt();
         let num = weighting(b * (-kappa + p.r_hy1), p.r_cy1, p.r_ey1);
@@ -151,7 +151,13 @@ impl TireCurves {
 
     /// Combined-slip forces at normal load `fz_n`, clipped to the friction circle μ·Fz.
     #[inline]
-    pub fn combined(&self, p: &TireParams, fz_n: f64, kappa: f64, alpha_rad: f64) -> TireForces {
+    pub(crate) fn combined(
+        &self,
+        p: &TireParams,
+        fz_n: f64,
+        kappa: f64,
+        alpha_rad: f64,
+    ) -> TireForces {
         if fz_n <= 0.0 {
             return TireForces::default();
         }
@@ -178,7 +184,7 @@ impl TireCurves {
 
     /// Linear cornering stiffness of one tyre at load `fz_n`, |∂F_y/∂α| at α = κ = 0 (N/rad).
     /// Equals |p_ky1|·Fz: independent of μ.
-    pub fn cornering_stiffness_npr(p: &TireParams, fz_n: f64) -> f64 {
+    pub(crate) fn cornering_stiffness_npr(p: &TireParams, fz_n: f64) -> f64 {
         p.p_ky1.abs() * fz_n
     }
 }

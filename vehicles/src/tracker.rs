@@ -133,7 +133,7 @@ pub struct SpeedController {
 
 impl SpeedController {
     /// A controller for a car with these parameters.
-    pub fn new(params: TrackerParams, vehicle: &VehicleParams) -> Self {
+    pub(crate) fn new(params: TrackerParams, vehicle: &VehicleParams) -> Self {
         Self {
             params,
             vehicle: vehicle.clone(),
@@ -154,7 +154,7 @@ impl SpeedController {
     /// u = a_ff + K_p e + K_i ∫e dt − K_d dv/dt. Anti-windup by conditional integration: the
     /// error is integrated only inside the band |e| < `speed_integral_band_mps`, and then only if
     /// the output is not saturated or if integrating moves it back inside.
-    pub fn acceleration_demand_mps2(
+    pub(crate) fn acceleration_demand_mps2(
         &mut self,
         target_mps: f64,
         feedforward_mps2: f64,
@@ -194,7 +194,7 @@ impl SpeedController {
 
     /// Estimated normal load of each wheel (FL, FR, RL, RR) under longitudinal acceleration
     /// `accel_mps2`: static loads plus the pitch transfer m·a·h / L, floored at 0 (N).
-    pub fn estimated_wheel_loads_n(&self, accel_mps2: f64) -> [f64; 4] {
+    pub(crate) fn estimated_wheel_loads_n(&self, accel_mps2: f64) -> [f64; 4] {
         let v = &self.vehicle;
         let l = v.wheelbase_m();
         let transfer = v.mass_kg * accel_mps2 * v.cog_height_m / l;
@@ -208,7 +208,7 @@ impl SpeedController {
     /// Wheel torques realising `accel_mps2`: total force m·a; drive split by the vehicle's drive
     /// share, brakes in proportion to the estimated loads; each wheel limited to μ·Fz·r and to
     /// its actuator limit.
-    pub fn torques_for(&self, accel_mps2: f64) -> ([f64; 4], [f64; 4]) {
+    pub(crate) fn torques_for(&self, accel_mps2: f64) -> ([f64; 4], [f64; 4]) {
         let v = &self.vehicle;
         let r = v.wheel_radius_m;
         let mu = self.params.friction_coefficient;
@@ -243,7 +243,7 @@ impl SpeedController {
     }
 
     /// Torques holding a stopped car: half the transmittable brake torque on every wheel.
-    pub fn holding_brake_nm(&self) -> [f64; 4] {
+    pub(crate) fn holding_brake_nm(&self) -> [f64; 4] {
         let loads = self.estimated_wheel_loads_n(0.0);
         let mut brake = [0.0; 4];
         for (i, torque) in brake.iter_mut().enumerate() {
@@ -255,12 +255,17 @@ impl SpeedController {
     }
 
     /// Drive / brake torques tracking `target_mps` (wheel order FL, FR, RL, RR).
-    pub fn update(&mut self, target_mps: f64, speed_mps: f64, dt_s: f64) -> ([f64; 4], [f64; 4]) {
+    pub(crate) fn update(
+        &mut self,
+        target_mps: f64,
+        speed_mps: f64,
+        dt_s: f64,
+    ) -> ([f64; 4], [f64; 4]) {
         self.update_with_feedforward(target_mps, 0.0, speed_mps, dt_s)
     }
 
     /// [`update`](Self::update) with a feed-forward acceleration (m/s²).
-    pub fn update_with_feedforward(
+    pub(crate) fn update_with_feedforward(
         &mut self,
         target_mps: f64,
         feedforward_mps2: f64,

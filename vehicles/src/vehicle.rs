@@ -304,7 +304,7 @@ impl Vehicle {
     }
 
     /// Suspension and tyre forces for the coming step, at road friction `mu` (call once before
-    /// each `world.step()`). An unusable μ is clamped into [`MU_RANGE`] (NaN → lowest); use
+    /// each `world.step()`). An unusable μ is clamped into `MU_RANGE` (NaN → lowest); use
     /// [`try_apply_forces`](Self::try_apply_forces) to get an error instead. Does nothing if
     /// the chassis was removed from the world.
     pub fn apply_forces(&mut self, world: &mut PhysicsWorld, mu: f64) {
@@ -316,7 +316,7 @@ impl Vehicle {
         let _ = self.try_apply_forces(world, mu);
     }
 
-    /// [`apply_forces`](Self::apply_forces) that rejects μ outside [`MU_RANGE`] and reports a
+    /// [`apply_forces`](Self::apply_forces) that rejects μ outside `MU_RANGE` and reports a
     /// missing chassis.
     pub fn try_apply_forces(
         &mut self,

@@ -31,10 +31,10 @@ use crate::clarabel_setup::{new_solver, solve_checked, solver_failed};
 use crate::error::PlannerError;
 
 /// Offset of v_1 in the decision vector.
-pub const V_OFFSET: usize = 0;
+pub(crate) const V_OFFSET: usize = 0;
 
 /// Offset of t_1 in the decision vector of an N-speed problem.
-pub const fn t_offset(n: usize) -> usize {
+pub(crate) const fn t_offset(n: usize) -> usize {
     n
 }
 

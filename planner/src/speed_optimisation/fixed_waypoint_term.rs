@@ -24,7 +24,7 @@ use crate::types::VehicleShape;
 
 /// One other vehicle at one slot: its field centred on its shared waypoint, and what D_min needs.
 #[derive(Clone, Debug)]
-pub struct SlotOther {
+pub(crate) struct SlotOther {
     /// Its field (σ's are recomputed from v_i; the centre and heading are used as they are).
     pub field: ObstacleField,
     /// Its speed at the slot (m/s).
@@ -51,7 +51,7 @@ pub struct FixedWaypointTerm {
 
 impl FixedWaypointTerm {
     /// The term for the ego's `waypoints` and the others at the same slots; `floor` is ε_I.
-    pub fn new(
+    pub(crate) fn new(
         field_params: ObstacleFieldParams,
         ego_shape: VehicleShape,
         floor: f64,

@@ -1,7 +1,7 @@
 //! The friction speed limit of Eq. 10a.
 
 /// the segment's ends and middle. κ → 0 is guarded: below μ g / V_limit² the limit is V_limit.
-pub fn friction_speed_limits(
+pub(crate) fn friction_speed_limits(
     curvature_per_m: impl Fn(f64) -> f64,
     waypoint_xi_m: &[f64],
     mu: f64,

@@ -51,7 +51,7 @@ impl InteractionTerm {
     /// The ego moves along `path` (starting at its current position, tangent
     /// `fallback_tangent` if the path is degenerate); `fields[i]` are the others' fields at
     /// t_0 + (i + 1)·Δt.
-    pub fn new(
+    pub(crate) fn new(
         path: Polyline,
         fallback_tangent: [f64; 2],
         step_time_s: f64,

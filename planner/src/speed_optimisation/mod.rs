@@ -1,11 +1,11 @@
 //! Interactive speed optimisation, paper Eq. 10, solved by sequential convex programming
 //! (SCP) with Clarabel.
 //!
-//! Files: [`scp`] (the SCP loop and its line search), [`cone_program`] (the convex
-//! subproblem: decision vector, constraint rows and their assembly), [`newton_qp`] (the same
+//! Files: `scp` (the SCP loop and its line search), `cone_program` (the convex
+//! subproblem: decision vector, constraint rows and their assembly), `newton_qp` (the same
 //! subproblem with the travel time's second-order model: a QP, `speed_program = "newton-qp"`), [`interaction_term`]
 //! (U_SLP at the planned arc length, and PF-SP's risk term), [`fixed_waypoint_term`] (U_SLP as
-//! the paper prints it), [`friction_limits`] (Eq. 10a).
+//! the paper prints it), `friction_limits` (Eq. 10a).
 //!
 //! # The problem (Eq. 10, as read here)
 //!
@@ -39,9 +39,9 @@
 //!
 //! Each SCP iteration solves a convex subproblem, posed one of two ways
 //! (`PlannerParams::speed_program`): [`SpeedProgram::Cone`] keeps the travel time exact: t_i ≥ Δs_i / v_i ⇔ t_i v_i ≥ Δs_i, t_i, v_i ≥ 0
-//! ⇔ ‖(t_i − v_i, 2√Δs_i)‖ ≤ t_i + v_i, a second-order cone ([`cone_program`]);
+//! ⇔ ‖(t_i − v_i, 2√Δs_i)‖ ≤ t_i + v_i, a second-order cone (`cone_program`);
 //! [`SpeedProgram::NewtonQp`] replaces it by its second-order Taylor model at the iterate, a QP
-//! ([`newton_qp`]), cheaper per solve (the default). What follows is written for the cone program; the QP
+//! (`newton_qp`), cheaper per solve (the default). What follows is written for the cone program; the QP
 //! differs only where said. The interaction term is
 //! linearised at the current iterate v̄ (φ ≈ φ(v̄) + ∇φ(v̄)ᵀ(v − v̄)), the resulting convex
 //! cone program is solved inside the trust region |v_i − v̄_i| ≤ ρ, and the step d = v* − v̄
@@ -65,20 +65,20 @@
 //! iterations, and consecutive planning cycles, reuse one Clarabel solver through `update_q` /
 //! `update_b` (and, for the QP, `update_P` of its diagonal): A is fixed.
 //!
-//! The non-convex term is any [`SpeedTerm`]: w3·Σ φ_i of PF-ISO (either reading of U_SLP), or
-//! w_R·Σ U_i of PF-SP's risk-aware speeds, with its own weight in [`SpeedProblem`].
+//! The non-convex term is any `SpeedTerm`: w3·Σ φ_i of PF-ISO (either reading of U_SLP), or
+//! w_R·Σ U_i of PF-SP's risk-aware speeds, with its own weight in `SpeedProblem`.
 
-pub mod cone_program;
+pub(crate) mod cone_program;
 pub mod fixed_waypoint_term;
-pub mod friction_limits;
+pub(crate) mod friction_limits;
 pub mod interaction_term;
-pub mod newton_qp;
-pub mod scp;
+pub(crate) mod newton_qp;
+pub(crate) mod scp;
 
 pub use fixed_waypoint_term::FixedWaypointTerm;
-pub use friction_limits::friction_speed_limits;
+pub(crate) use friction_limits::friction_speed_limits;
 pub use interaction_term::{Aggregate, InteractionTerm};
-pub use scp::SpeedOptimiser;
+pub(crate) use scp::SpeedOptimiser;
 
 use serde::{Deserialize, Serialize};
 
@@ -89,11 +89,11 @@ use crate::clarabel_setup::ProgramSettings;
 #[serde(rename_all = "kebab-case")]
 pub enum SpeedProgram {
     /// The travel time exactly, t_i v_i ≥ Δs_i as one second-order cone per segment
-    /// ([`cone_program`]): a convex problem (no interaction term) is solved exactly in one
+    /// (`cone_program`): a convex problem (no interaction term) is solved exactly in one
     /// solve.
     Cone,
     /// The travel time by its second-order Taylor model at the iterate: a QP with no cones and
-    /// no t variables ([`newton_qp`]), a third of the cost per solve; the SCP then iterates on
+    /// no t variables (`newton_qp`), a third of the cost per solve; the SCP then iterates on
     /// convex problems too. The default: iterated to convergence (the default
     /// `max_scp_iterations` and `scp_stall_trust_region_mps`) it reaches the cone program's
     /// optimum at 2–3× less cost per planning cycle (docs/parameters.md).
@@ -163,7 +163,7 @@ pub struct SpeedOptimiserParams {
 }
 
 /// A smooth, possibly non-convex term Σ_i φ_i(v) of the speed objective, linearised by the SCP.
-pub trait SpeedTerm: std::fmt::Debug {
+pub(crate) trait SpeedTerm: std::fmt::Debug {
     /// Number of time slots (one per speed).
     fn slots(&self) -> usize;
 
@@ -178,7 +178,7 @@ pub trait SpeedTerm: std::fmt::Debug {
 
 /// One speed problem (module doc).
 #[derive(Clone, Copy, Debug)]
-pub struct SpeedProblem<'a> {
+pub(crate) struct SpeedProblem<'a> {
     /// v_0, the current speed (m/s): anchors v_1 when the acceleration bound is on.
     pub current_speed_mps: f64,
     /// V_target (m/s).
@@ -197,7 +197,7 @@ pub struct SpeedProblem<'a> {
 
 /// The optimiser's answer.
 #[derive(Clone, Debug, PartialEq)]
-pub struct SpeedSolution {
+pub(crate) struct SpeedSolution {
     /// v_1..v_N (m/s).
     pub speeds_mps: Vec<f64>,
     /// J(v) (true objective, not the linearised one).

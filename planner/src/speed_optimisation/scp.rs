@@ -12,7 +12,7 @@ use crate::error::PlannerError;
 /// The speed optimiser. Holds a Clarabel solver between solves (and planning cycles) so only
 /// q and b are rewritten; it is rebuilt when the problem's structure changes.
 #[derive(Default)]
-pub struct SpeedOptimiser {
+pub(crate) struct SpeedOptimiser {
     pub(super) cached: Option<CachedSolver>,
     pub(super) cached_qp: Option<CachedQp>,
 }
@@ -93,7 +93,7 @@ impl SpeedOptimiser {
     /// Solves one speed problem (module doc). Errors when the first convex solve fails
     /// (status other than Solved / AlmostSolved, or a non-finite value); later SCP
     /// iterations that fail just end the iteration with the last accepted speeds.
-    pub fn solve(
+    pub(crate) fn solve(
         &mut self,
         params: &SpeedOptimiserParams,
         problem: &SpeedProblem<'_>,

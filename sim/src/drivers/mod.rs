@@ -3,10 +3,10 @@
 //! (a planner's path at a prescribed time → speed profile). The potential-field planners are the
 //! planner crate's; a user's planner is registered by name (`crate::registry`).
 
-pub mod idm_driver;
-pub mod lane_keeping;
-pub mod prescribed_speed;
+pub(crate) mod idm_driver;
+pub(crate) mod lane_keeping;
+pub(crate) mod prescribed_speed;
 
-pub use idm_driver::IdmDriver;
+pub(crate) use idm_driver::IdmDriver;
 pub use lane_keeping::{LaneKeeping, lane_path};
-pub use prescribed_speed::PrescribedSpeed;
+pub(crate) use prescribed_speed::PrescribedSpeed;

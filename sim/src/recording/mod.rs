@@ -193,7 +193,7 @@ pub struct RecorderParams {
 
 /// Vehicles whose fields and received paths are recorded by default (every built-in scenario
 /// but the dense merge and the platoon has at most this many).
-pub const DEFAULT_DETAIL_VEHICLES: usize = 4;
+pub(crate) const DEFAULT_DETAIL_VEHICLES: usize = 4;
 
 impl Default for RecorderParams {
     fn default() -> Self {

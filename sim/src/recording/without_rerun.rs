@@ -24,22 +24,22 @@ impl Recorder {
     }
 
     /// No-op (no recording can be open).
-    pub fn set_time(&mut self, _t_s: f64) -> Result<(), RecordingError> {
+    pub(crate) fn set_time(&mut self, _t_s: f64) -> Result<(), RecordingError> {
         Ok(())
     }
 
     /// No-op (no recording can be open).
-    pub fn finish(self) -> Result<(), RecordingError> {
+    pub(crate) fn finish(self) -> Result<(), RecordingError> {
         Ok(())
     }
 
     /// Always `None`.
-    pub fn tmp_path(&self) -> Option<&Path> {
+    pub(crate) fn tmp_path(&self) -> Option<&Path> {
         None
     }
 
     /// No-op.
-    pub fn log_road(
+    pub(crate) fn log_road(
         &mut self,
         _lanes: &mergesim_types::lanes::LaneRoad,
     ) -> Result<(), RecordingError> {
@@ -47,7 +47,7 @@ impl Recorder {
     }
 
     /// No-op.
-    pub fn log_vehicles(
+    pub(crate) fn log_vehicles(
         &mut self,
         _bodies: &[BodyState],
         _names: &[String],
@@ -56,7 +56,7 @@ impl Recorder {
     }
 
     /// No-op.
-    pub fn log_recorded_vehicles(
+    pub(crate) fn log_recorded_vehicles(
         &mut self,
         _bodies: &[BodyState],
         _names: &[String],
@@ -65,7 +65,7 @@ impl Recorder {
     }
 
     /// No-op.
-    pub fn log_planned_path(
+    pub(crate) fn log_planned_path(
         &mut self,
         _name: &str,
         _path: &[PathPoint],
@@ -74,7 +74,7 @@ impl Recorder {
     }
 
     /// No-op.
-    pub fn log_received_paths(
+    pub(crate) fn log_received_paths(
         &mut self,
         _name: &str,
         _paths: &[SharedLocalPath],
@@ -84,7 +84,7 @@ impl Recorder {
 
     /// No-op.
     #[allow(clippy::too_many_arguments)]
-    pub fn log_field(
+    pub(crate) fn log_field(
         &mut self,
         _name: &str,
         _x0_m: f64,
@@ -98,7 +98,7 @@ impl Recorder {
     }
 
     /// No-op.
-    pub fn log_scalars(
+    pub(crate) fn log_scalars(
         &mut self,
         _name: &str,
         _values: &[(&str, f64)],
@@ -107,7 +107,11 @@ impl Recorder {
     }
 
     /// No-op.
-    pub fn log_event(&mut self, _text: &str, _level: EventLevel) -> Result<(), RecordingError> {
+    pub(crate) fn log_event(
+        &mut self,
+        _text: &str,
+        _level: EventLevel,
+    ) -> Result<(), RecordingError> {
         Ok(())
     }
 }

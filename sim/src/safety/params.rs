@@ -63,7 +63,7 @@ pub const SAFETY_BOUNDS: &[Bound] = &[
 impl SafetyParams {
     /// Checks every field against [`SAFETY_BOUNDS`] and the horizon against the threshold; the
     /// error names the field.
-    pub fn validate(&self) -> Result<(), SafetyError> {
+    pub(crate) fn validate(&self) -> Result<(), SafetyError> {
         bounds::check_all(
             "safety",
             SAFETY_BOUNDS,
