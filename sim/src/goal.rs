@@ -192,7 +192,9 @@ impl GoalState {
     /// of the run, s) meets every condition of this goal state.
     pub fn is_met(&self, t_s: f64, state: &VehicleState, lanes: &LaneRoad) -> bool {
         self.time_s.is_none_or(|i| i.contains(t_s))
-            && self.velocity_mps.is_none_or(|i| i.contains(state.speed_mps))
+            && self
+                .velocity_mps
+                .is_none_or(|i| i.contains(state.speed_mps))
             && self
                 .orientation_rad
                 .is_none_or(|i| i.contains_angle(state.yaw_rad))

@@ -152,7 +152,9 @@ impl TickObserver for RecordingObserver {
                     ],
                 )
                 .map_err(rec)?;
-            recorder.log_planned_path(&v.sample.vehicle, v.path).map_err(rec)?;
+            recorder
+                .log_planned_path(&v.sample.vehicle, v.path)
+                .map_err(rec)?;
             if v.connected && (v.id as usize) < detail_below {
                 recorder
                     .log_received_paths(&v.sample.vehicle, v.received)
