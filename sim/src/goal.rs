@@ -9,6 +9,7 @@
 //! vehicle's centre of gravity (`crate::world`); the first instant found is the goal time.
 //! Intervals include their ends.
 
+use mergesim_types::VehicleState;
 use mergesim_types::lanes::{LaneId, LaneRoad};
 use serde::{Deserialize, Serialize};
 
@@ -186,31 +187,21 @@ pub struct GoalState {
     pub source: String,
 }
 
-/// The instant a goal is checked at: the vehicle's state.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct GoalCheck {
-    /// Time since the start of the run (s).
-    pub t_s: f64,
-    /// Centre of gravity (m).
-    pub position_m: [f64; 2],
-    /// Heading (rad).
-    pub heading_rad: f64,
-    /// Speed (m/s).
-    pub speed_mps: f64,
-}
-
 impl GoalState {
-    /// Whether the vehicle meets every condition of this state at `at`.
-    pub(crate) fn is_met(&self, at: &GoalCheck, lanes: &LaneRoad) -> bool {
-        self.time_s.is_none_or(|i| i.contains(at.t_s))
-            && self.velocity_mps.is_none_or(|i| i.contains(at.speed_mps))
+    /// Whether the vehicle in `state` (its centre of gravity) at time `t_s` (since the start
+    /// of the run, s) meets every condition of this goal state.
+    pub fn is_met(&self, t_s: f64, state: &VehicleState, lanes: &LaneRoad) -> bool {
+        self.time_s.is_none_or(|i| i.contains(t_s))
+            && self
+                .velocity_mps
+                .is_none_or(|i| i.contains(state.speed_mps))
             && self
                 .orientation_rad
-                .is_none_or(|i| i.contains_angle(at.heading_rad))
+                .is_none_or(|i| i.contains_angle(state.yaw_rad))
             && self
                 .position
                 .as_ref()
-                .is_none_or(|p| p.contains(at.position_m, lanes))
+                .is_none_or(|p| p.contains([state.x_m, state.y_m], lanes))
     }
 }
 
@@ -223,9 +214,9 @@ pub struct Goal {
 }
 
 impl Goal {
-    /// Whether the vehicle meets one of the goal states at `at`.
-    pub(crate) fn is_reached(&self, at: &GoalCheck, lanes: &LaneRoad) -> bool {
-        self.states.iter().any(|s| s.is_met(at, lanes))
+    /// Whether the vehicle in `state` at time `t_s` (s) meets one of the goal states.
+    pub fn is_reached(&self, t_s: f64, state: &VehicleState, lanes: &LaneRoad) -> bool {
+        self.states.iter().any(|s| s.is_met(t_s, state, lanes))
     }
 
     /// The latest end of the goal states' time intervals (s), if every state has one (the

@@ -17,13 +17,23 @@ fn two_lanes() -> LaneRoad {
     .unwrap()
 }
 
-fn at(t_s: f64, p: [f64; 2], heading_rad: f64, speed_mps: f64) -> GoalCheck {
-    GoalCheck {
-        t_s,
-        position_m: p,
-        heading_rad,
+/// Whether `goal` is reached at `t_s` by a vehicle at `p` with heading `yaw_rad` and speed
+/// `speed_mps`.
+fn reached(
+    goal: &Goal,
+    t_s: f64,
+    p: [f64; 2],
+    yaw_rad: f64,
+    speed_mps: f64,
+    road: &LaneRoad,
+) -> bool {
+    let state = VehicleState {
+        x_m: p[0],
+        y_m: p[1],
+        yaw_rad,
         speed_mps,
-    }
+    };
+    goal.is_reached(t_s, &state, road)
 }
 
 fn iv(start: f64, end: f64) -> Option<Interval> {
@@ -39,7 +49,7 @@ fn a_time_only_goal_is_reached_inside_its_interval_ends_included() {
             ..GoalState::default()
         }],
     };
-    let anywhere = |t| goal.is_reached(&at(t, [1e4, -1e4], 2.0, 99.0), &road);
+    let anywhere = |t| reached(&goal, t, [1e4, -1e4], 2.0, 99.0, &road);
     assert!(!anywhere(2.99));
     assert!(anywhere(3.0));
     assert!(anywhere(3.5));
@@ -61,11 +71,11 @@ fn every_condition_of_one_state_must_hold_at_the_same_instant() {
         }],
     };
     // All three hold.
-    assert!(goal.is_reached(&at(5.0, [50.0, 3.5], 0.0, 11.0), &road));
+    assert!(reached(&goal, 5.0, [50.0, 3.5], 0.0, 11.0, &road));
     // Each one missing in turn.
-    assert!(!goal.is_reached(&at(11.0, [50.0, 3.5], 0.0, 11.0), &road));
-    assert!(!goal.is_reached(&at(5.0, [50.0, 3.5], 0.0, 9.9), &road));
-    assert!(!goal.is_reached(&at(5.0, [50.0, 0.0], 0.0, 11.0), &road));
+    assert!(!reached(&goal, 11.0, [50.0, 3.5], 0.0, 11.0, &road));
+    assert!(!reached(&goal, 5.0, [50.0, 3.5], 0.0, 9.9, &road));
+    assert!(!reached(&goal, 5.0, [50.0, 0.0], 0.0, 11.0, &road));
     assert_eq!(goal.velocity_midpoint_mps(), Some(11.0));
 }
 
@@ -86,9 +96,9 @@ fn any_one_goal_state_is_enough() {
         ],
     };
     // In lane 1 too slow for the first state, but the second needs lane 2.
-    assert!(!goal.is_reached(&at(1.0, [50.0, 0.0], 0.0, 10.0), &road));
-    assert!(goal.is_reached(&at(1.0, [50.0, 0.0], 0.0, 25.0), &road));
-    assert!(goal.is_reached(&at(1.0, [50.0, 3.5], 0.0, 10.0), &road));
+    assert!(!reached(&goal, 1.0, [50.0, 0.0], 0.0, 10.0, &road));
+    assert!(reached(&goal, 1.0, [50.0, 0.0], 0.0, 25.0, &road));
+    assert!(reached(&goal, 1.0, [50.0, 3.5], 0.0, 10.0, &road));
     // A time interval missing from one state: no time end for the goal.
     assert_eq!(goal.time_end_s(), None);
 }
@@ -134,8 +144,8 @@ fn shapes_rectangle_rotated_circle_and_polygon() {
             ..GoalState::default()
         }],
     };
-    assert!(goal.is_reached(&at(0.0, [0.5, 3.0], 0.0, 0.0), &road));
-    assert!(!goal.is_reached(&at(0.0, [3.0, 3.0], 0.0, 0.0), &road));
+    assert!(reached(&goal, 0.0, [0.5, 3.0], 0.0, 0.0, &road));
+    assert!(!reached(&goal, 0.0, [3.0, 3.0], 0.0, 0.0, &road));
 }
 
 #[test]
@@ -166,6 +176,6 @@ fn orientation_is_compared_modulo_a_turn() {
             ..GoalState::default()
         }],
     };
-    assert!(goal.is_reached(&at(0.0, [50.0, 0.0], 0.1, 10.0), &road));
-    assert!(!goal.is_reached(&at(0.0, [50.0, 0.0], 0.5, 10.0), &road));
+    assert!(reached(&goal, 0.0, [50.0, 0.0], 0.1, 10.0, &road));
+    assert!(!reached(&goal, 0.0, [50.0, 0.0], 0.5, 10.0, &road));
 }

@@ -1,7 +1,7 @@
 //! Per-vehicle motion, comfort and oscillation metrics (the paper's Table / Figs.
 //! 7–9 report peak sideslip, yaw and yaw rate, and the speed profile).
 //!
-//! [`VehicleMetrics`] is fed one [`MetricsSample`] per logged instant and keeps running figures,
+//! [`VehicleMetrics`] is fed one [`TimeSeriesRow`] per logged instant and keeps running figures,
 //! so memory does not grow with the run length.
 //!
 //! Integrals treat the samples as a piecewise-linear signal and integrate that exactly:
@@ -17,6 +17,7 @@ use mergesim_types::InvalidParameter;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crate::outcome::TimeSeriesRow;
 use crate::paper_metrics::{PaperMetrics, PaperMetricsSummary};
 
 /// Thresholds and windows of the metrics.
@@ -92,45 +93,22 @@ pub enum MetricsError {
     },
 }
 
-/// The motion state of a vehicle at one logged instant (world frame, SI).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct MetricsSample {
-    /// Time (s).
-    pub t_s: f64,
-    /// Position (m).
-    pub x_m: f64,
-    /// Position (m).
-    pub y_m: f64,
-    /// Heading (rad).
-    pub yaw_rad: f64,
-    /// Yaw rate (rad/s).
-    pub yaw_rate_radps: f64,
-    /// Sideslip angle β at the centre of gravity (rad).
-    pub sideslip_rad: f64,
-    /// Speed over ground (m/s).
-    pub speed_mps: f64,
-    /// Longitudinal acceleration, body frame (m/s²).
-    pub accel_long_mps2: f64,
-    /// Lateral acceleration, body frame (m/s²).
-    pub accel_lat_mps2: f64,
-}
-
-impl MetricsSample {
-    fn first_non_finite(&self) -> Option<(&'static str, f64)> {
-        [
-            ("t_s", self.t_s),
-            ("x_m", self.x_m),
-            ("y_m", self.y_m),
-            ("yaw_rad", self.yaw_rad),
-            ("yaw_rate_radps", self.yaw_rate_radps),
-            ("sideslip_rad", self.sideslip_rad),
-            ("speed_mps", self.speed_mps),
-            ("accel_long_mps2", self.accel_long_mps2),
-            ("accel_lat_mps2", self.accel_lat_mps2),
-        ]
-        .into_iter()
-        .find(|(_, v)| !v.is_finite())
-    }
+/// The first motion field of `s` that is NaN or infinite, as `(field name, value)`.
+/// `planned_speed_mps` is not a motion figure and is not checked.
+fn first_non_finite(s: &TimeSeriesRow) -> Option<(&'static str, f64)> {
+    [
+        ("t_s", s.t_s),
+        ("x_m", s.x_m),
+        ("y_m", s.y_m),
+        ("yaw_rad", s.yaw_rad),
+        ("yaw_rate_radps", s.yaw_rate_radps),
+        ("sideslip_rad", s.sideslip_rad),
+        ("speed_mps", s.speed_mps),
+        ("accel_long_mps2", s.accel_long_mps2),
+        ("accel_lat_mps2", s.accel_lat_mps2),
+    ]
+    .into_iter()
+    .find(|(_, v)| !v.is_finite())
 }
 
 /// The metrics of one vehicle over a run.
@@ -289,8 +267,8 @@ fn wrap_angle_rad(angle_rad: f64) -> f64 {
 pub struct VehicleMetrics {
     id: String,
     params: MetricsParams,
-    first: Option<MetricsSample>,
-    last: Option<MetricsSample>,
+    first_t_s: Option<f64>,
+    last: Option<TimeSeriesRow>,
     samples: u64,
     max_abs_sideslip_rad: f64,
     t_max_abs_sideslip_s: f64,
@@ -327,7 +305,7 @@ impl VehicleMetrics {
         Self {
             id,
             params,
-            first: None,
+            first_t_s: None,
             last: None,
             samples: 0,
             max_abs_sideslip_rad: 0.0,
@@ -378,8 +356,8 @@ impl VehicleMetrics {
     }
 
     /// Adds the sample of the next logged instant (times must strictly increase).
-    pub fn push(&mut self, sample: &MetricsSample) -> Result<(), MetricsError> {
-        if let Some((field, value)) = sample.first_non_finite() {
+    pub fn push(&mut self, sample: &TimeSeriesRow) -> Result<(), MetricsError> {
+        if let Some((field, value)) = first_non_finite(sample) {
             return Err(MetricsError::NonFinite {
                 field,
                 value,
@@ -416,9 +394,9 @@ impl VehicleMetrics {
             self.window_sign_changes.push(s.yaw_rate_radps, thr);
         }
 
-        match self.last {
+        match &self.last {
             None => {
-                self.first = Some(*s);
+                self.first_t_s = Some(s.t_s);
                 self.accel_long.first(s.accel_long_mps2);
                 self.accel_lat.first(s.accel_lat_mps2);
             }
@@ -439,7 +417,7 @@ impl VehicleMetrics {
         if let Some(paper) = &mut self.paper {
             paper.push(s);
         }
-        self.last = Some(*s);
+        self.last = Some(s.clone());
         self.samples += 1;
         Ok(())
     }
@@ -452,9 +430,9 @@ impl VehicleMetrics {
     /// The figures so far. Before the first sample every figure is 0 and `samples` is 0.
     pub fn summary(&self) -> VehicleMetricsSummary {
         let (duration_s, last_accel_long, last_accel_lat, final_speed_mps) =
-            match (self.first, self.last) {
-                (Some(first), Some(last)) => (
-                    last.t_s - first.t_s,
+            match (self.first_t_s, &self.last) {
+                (Some(first_t_s), Some(last)) => (
+                    last.t_s - first_t_s,
                     last.accel_long_mps2,
                     last.accel_lat_mps2,
                     last.speed_mps,

@@ -13,8 +13,8 @@ use vehicles::Kinematics;
 
 use crate::error::SimError;
 use crate::event::SimEvent;
-use crate::metrics::MetricsSample;
 use crate::profile::Phase;
+use crate::outcome::TimeSeriesRow;
 use crate::safety::BodyState;
 
 /// One vehicle at a logged instant.
@@ -22,18 +22,15 @@ use crate::safety::BodyState;
 pub struct VehicleView<'a> {
     /// Its id (index in the scenario).
     pub id: VehicleId,
-    /// Its name.
-    pub name: &'a str,
     /// Its kinematic state.
     pub kinematics: &'a Kinematics,
     /// Its chassis box, as the safety checks see it.
     pub body: &'a BodyState,
-    /// Its motion state as the metrics see it.
-    pub sample: &'a MetricsSample,
+    /// Its row of the time series: its name, the motion state the metrics see and the speed
+    /// its plan asks for now.
+    pub sample: &'a TimeSeriesRow,
     /// The path it is tracking.
     pub path: &'a [PathPoint],
-    /// The speed that path asks for now (m/s).
-    pub planned_speed_mps: f64,
     /// Whether it is connected (sends and receives shared paths).
     pub connected: bool,
     /// The fresh shared paths it holds (empty unless an observer asked for them).

@@ -1,12 +1,19 @@
 //! What a run produces: the outcome, its planner statistics and the time-series rows.
 
 use serde::{Deserialize, Serialize};
+use vehicles::Kinematics;
 
-use crate::metrics::{MetricsSample, VehicleMetricsSummary};
+use crate::metrics::VehicleMetricsSummary;
 use crate::safety::SafetySummary;
 use crate::v2v::V2vStats;
 
-/// One row of the time series (`--csv`).
+/// One simulated vehicle at one logged instant (world frame, SI): a row of the time series
+/// (`--csv`) and the sample the per-vehicle metrics ([`crate::metrics::VehicleMetrics`]) are
+/// fed. The world makes one per vehicle and log instant ([`TimeSeriesRow::at`]) and hands it to
+/// the observers in [`crate::observer::VehicleView::sample`].
+///
+/// Field order is the CSV's column order ([`TimeSeriesRow::CSV_HEADER`]) and the JSON's key
+/// order.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TimeSeriesRow {
     /// Simulated time (s).
@@ -21,9 +28,9 @@ pub struct TimeSeriesRow {
     pub yaw_rad: f64,
     /// Yaw rate (rad/s).
     pub yaw_rate_radps: f64,
-    /// Sideslip at the centre of gravity (rad).
+    /// Sideslip angle β at the centre of gravity (rad).
     pub sideslip_rad: f64,
-    /// Speed (m/s).
+    /// Speed over ground (m/s).
     pub speed_mps: f64,
     /// Speed the current plan asks for now (m/s).
     pub planned_speed_mps: f64,
@@ -34,20 +41,21 @@ pub struct TimeSeriesRow {
 }
 
 impl TimeSeriesRow {
-    /// The row of vehicle `name` for one metrics sample and the speed its plan asked for.
-    pub fn from_sample(name: &str, sample: &MetricsSample, planned_speed_mps: f64) -> Self {
+    /// The row of the vehicle named `vehicle` at time `t_s`, in the kinematic state
+    /// `kinematics`, whose plan asks for `planned_speed_mps`.
+    pub fn at(t_s: f64, vehicle: &str, kinematics: &Kinematics, planned_speed_mps: f64) -> Self {
         Self {
-            t_s: sample.t_s,
-            vehicle: name.to_string(),
-            x_m: sample.x_m,
-            y_m: sample.y_m,
-            yaw_rad: sample.yaw_rad,
-            yaw_rate_radps: sample.yaw_rate_radps,
-            sideslip_rad: sample.sideslip_rad,
-            speed_mps: sample.speed_mps,
+            t_s,
+            vehicle: vehicle.to_string(),
+            x_m: kinematics.x_m,
+            y_m: kinematics.y_m,
+            yaw_rad: kinematics.yaw_rad,
+            yaw_rate_radps: kinematics.yaw_rate_radps,
+            sideslip_rad: kinematics.sideslip_rad,
+            speed_mps: kinematics.speed_mps,
             planned_speed_mps,
-            accel_long_mps2: sample.accel_long_mps2,
-            accel_lat_mps2: sample.accel_lat_mps2,
+            accel_long_mps2: kinematics.accel_long_mps2,
+            accel_lat_mps2: kinematics.accel_lat_mps2,
         }
     }
 
@@ -98,7 +106,8 @@ pub struct PlannerStats {
     pub p99_plan_us: f64,
 }
 
-/// A recorded vehicle's box at one log instant.
+/// A recorded vehicle's box at one log instant, as the output keeps it for the GIF: named,
+/// without the velocities of the [`crate::body_state::BodyState`] it is made from.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RecordedPose {
     /// Simulated time (s).

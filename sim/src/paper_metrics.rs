@@ -27,7 +27,7 @@ use mergesim_types::lanes::{LaneId, LaneRoad};
 use serde::{Deserialize, Serialize};
 
 use crate::lane_membership::{MergeZone, beyond_divider_m, lane_change, lane_of};
-use crate::metrics::MetricsSample;
+use crate::outcome::TimeSeriesRow;
 
 pub use crate::lane_membership::MERGE_ZONE_TAIL_M;
 
@@ -72,7 +72,7 @@ pub(crate) struct PaperMetrics {
     lanes: Arc<LaneRoad>,
     zone: Option<MergeZone>,
     target_speed_mps: f64,
-    last: Option<MetricsSample>,
+    last: Option<TimeSeriesRow>,
     lane: Option<LaneId>,
     slowing_onset_s: Option<f64>,
     zone_integral_sq: f64,
@@ -106,7 +106,7 @@ impl PaperMetrics {
     }
 
     /// Adds the next sample (the caller checks finiteness and increasing time).
-    pub(crate) fn push(&mut self, s: &MetricsSample) {
+    pub fn push(&mut self, s: &TimeSeriesRow) {
         if self.slowing_onset_s.is_none()
             && s.speed_mps < self.target_speed_mps - SLOWING_THRESHOLD_MPS
         {
@@ -118,7 +118,7 @@ impl PaperMetrics {
             let offset = (hit.frame.d_m - mid_d_m).abs();
             self.max_abs_lane_offset_m = self.max_abs_lane_offset_m.max(offset);
         }
-        if let Some(p) = self.last {
+        if let Some(p) = &self.last {
             let dt_s = s.t_s - p.t_s;
             let (r0, r1) = (p.yaw_rate_radps, s.yaw_rate_radps);
             let integral_sq = dt_s * (r0 * r0 + r0 * r1 + r1 * r1) / 3.0;
@@ -155,7 +155,7 @@ impl PaperMetrics {
             }
         }
         self.lane = Some(hit.lane);
-        self.last = Some(*s);
+        self.last = Some(s.clone());
     }
 
     /// The figures so far.
@@ -183,15 +183,17 @@ mod tests {
     use super::*;
     use mergesim_types::MergeRoad;
 
-    fn sample(t_s: f64, x_m: f64, y_m: f64, r: f64, v: f64) -> MetricsSample {
-        MetricsSample {
+    fn sample(t_s: f64, x_m: f64, y_m: f64, r: f64, v: f64) -> TimeSeriesRow {
+        TimeSeriesRow {
             t_s,
+            vehicle: "ego".into(),
             x_m,
             y_m,
             yaw_rad: 0.0,
             yaw_rate_radps: r,
             sideslip_rad: 0.0,
             speed_mps: v,
+            planned_speed_mps: v,
             accel_long_mps2: 0.0,
             accel_lat_mps2: 0.0,
         }

@@ -31,7 +31,10 @@ impl std::fmt::Display for TrafficMode {
     }
 }
 
-/// One recorded state.
+/// One recorded state: a recorded vehicle at one instant of its recording. It carries its own
+/// time (a recording is a list of them); a planner sees it as a
+/// [`mergesim_types::VehicleState`] (`From`), the safety checks as a
+/// [`crate::body_state::BodyState`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RecordedState {
     /// Time since the start of the run (s).
@@ -42,6 +45,19 @@ pub struct RecordedState {
     pub heading_rad: f64,
     /// Speed (m/s).
     pub speed_mps: f64,
+}
+
+/// What a planner perceives of a recorded vehicle in this state: its pose and speed (the time
+/// is the caller's).
+impl From<&RecordedState> for mergesim_types::VehicleState {
+    fn from(s: &RecordedState) -> Self {
+        Self {
+            x_m: s.position_m[0],
+            y_m: s.position_m[1],
+            yaw_rad: s.heading_rad,
+            speed_mps: s.speed_mps,
+        }
+    }
 }
 
 /// One recorded vehicle.

@@ -136,26 +136,28 @@ impl TickObserver for RecordingObserver {
         };
         recorder.set_time(t_s).map_err(rec)?;
         let bodies: Vec<BodyState> = vehicles.iter().map(|v| *v.body).collect();
-        let names: Vec<String> = vehicles.iter().map(|v| v.name.to_string()).collect();
+        let names: Vec<String> = vehicles.iter().map(|v| v.sample.vehicle.clone()).collect();
         recorder.log_vehicles(&bodies, &names).map_err(rec)?;
         for v in vehicles {
             let k = v.kinematics;
             recorder
                 .log_scalars(
-                    v.name,
+                    &v.sample.vehicle,
                     &[
                         ("sideslip_rad", k.sideslip_rad),
                         ("yaw_rad", k.yaw_rad),
                         ("yaw_rate_radps", k.yaw_rate_radps),
                         ("speed_mps", k.speed_mps),
-                        ("planned_speed_mps", v.planned_speed_mps),
+                        ("planned_speed_mps", v.sample.planned_speed_mps),
                     ],
                 )
                 .map_err(rec)?;
-            recorder.log_planned_path(v.name, v.path).map_err(rec)?;
+            recorder
+                .log_planned_path(&v.sample.vehicle, v.path)
+                .map_err(rec)?;
             if v.connected && (v.id as usize) < detail_below {
                 recorder
-                    .log_received_paths(v.name, v.received)
+                    .log_received_paths(&v.sample.vehicle, v.received)
                     .map_err(rec)?;
             }
         }

@@ -53,14 +53,10 @@ impl TickObserver for RunLog {
         for (metrics, v) in self.metrics.iter_mut().zip(vehicles) {
             metrics.push(v.sample).map_err(|e| SimError::Diverged {
                 t_s,
-                what: format!("metrics of {}: {e}", v.name),
+                what: format!("metrics of {}: {e}", v.sample.vehicle),
             })?;
             if self.keep_time_series {
-                self.time_series.push(TimeSeriesRow::from_sample(
-                    v.name,
-                    v.sample,
-                    v.planned_speed_mps,
-                ));
+                self.time_series.push(v.sample.clone());
             }
         }
         Ok(())

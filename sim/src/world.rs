@@ -19,7 +19,7 @@ use crate::config::{SimConfig, VehicleSpec};
 use crate::drivers::lane_path;
 use crate::error::SimError;
 use crate::event::SimEvent;
-use crate::metrics::{MetricsSample, VehicleMetrics};
+use crate::metrics::VehicleMetrics;
 use crate::observer::{TickObserver, VehicleView};
 use crate::outcome::RunOutcome;
 use crate::planner_stats::PlannerStatsObserver;

@@ -3,17 +3,20 @@
 
 use std::f64::consts::PI;
 
-use sim::metrics::{MetricsError, MetricsParams, MetricsSample, VehicleMetrics};
+use sim::TimeSeriesRow;
+use sim::metrics::{MetricsError, MetricsParams, VehicleMetrics};
 
-fn sample(t_s: f64) -> MetricsSample {
-    MetricsSample {
+fn sample(t_s: f64) -> TimeSeriesRow {
+    TimeSeriesRow {
         t_s,
+        vehicle: "ego".into(),
         x_m: 0.0,
         y_m: 0.0,
         yaw_rad: 0.0,
         yaw_rate_radps: 0.0,
         sideslip_rad: 0.0,
         speed_mps: 10.0,
+        planned_speed_mps: 10.0,
         accel_long_mps2: 0.0,
         accel_lat_mps2: 0.0,
     }
@@ -29,7 +32,7 @@ fn sinusoidal_yaw_rate_counts_two_changes_per_period_minus_one() {
     let n = (3.0 * 4.0 / dt) as usize;
     for k in 0..=n {
         let t = k as f64 * dt;
-        m.push(&MetricsSample {
+        m.push(&TimeSeriesRow {
             yaw_rate_radps: amplitude * (omega * t).sin(),
             ..sample(t)
         })
@@ -55,7 +58,7 @@ fn noise_below_the_threshold_and_dither_do_not_count() {
     let mut m = VehicleMetrics::new("ego");
     for k in 0..1000 {
         let t = k as f64 * 0.01;
-        m.push(&MetricsSample {
+        m.push(&TimeSeriesRow {
             yaw_rate_radps: 0.015 * (20.0 * t).sin(),
             ..sample(t)
         })
@@ -66,7 +69,7 @@ fn noise_below_the_threshold_and_dither_do_not_count() {
     // Hysteresis: +, small -, +, - beyond the threshold = one change only.
     let mut m = VehicleMetrics::new("ego");
     for (k, r) in [0.03, -0.01, 0.03, 0.0, -0.03, -0.05].iter().enumerate() {
-        m.push(&MetricsSample {
+        m.push(&TimeSeriesRow {
             yaw_rate_radps: *r,
             ..sample(k as f64)
         })
@@ -84,7 +87,7 @@ fn path_length_of_a_circle_arc_is_its_chord_sum_and_close_to_r_phi() {
     let mut m = VehicleMetrics::new("ego");
     for k in 0..=n {
         let theta = k as f64 * dtheta;
-        m.push(&MetricsSample {
+        m.push(&TimeSeriesRow {
             x_m: radius * theta.cos(),
             y_m: radius * theta.sin(),
             yaw_rad: theta + PI / 2.0,
@@ -112,7 +115,7 @@ fn acceleration_rms_jerk_and_extremes_match_closed_forms() {
     for k in 0..=n {
         let t = k as f64 * dt;
         let speed = 10.0 + 3.0 * (t - 1.3).powi(2);
-        m.push(&MetricsSample {
+        m.push(&TimeSeriesRow {
             accel_long_mps2: amp * (omega * t).sin(),
             accel_lat_mps2: -1.0,
             sideslip_rad: 0.05 * (omega * t).cos(),
@@ -151,7 +154,7 @@ fn oscillation_window_counts_only_inside_it() {
     let dt = 0.01;
     for k in 0..=1500 {
         let t = k as f64 * dt;
-        m.push(&MetricsSample {
+        m.push(&TimeSeriesRow {
             x_m: 20.0 * t,
             yaw_rate_radps: 0.1 * (PI * t).sin(),
             ..sample(t)
@@ -199,7 +202,7 @@ fn collided_flag_json_names_and_errors() {
         Err(MetricsError::TimeNotIncreasing { .. })
     ));
     assert!(matches!(
-        m.push(&MetricsSample {
+        m.push(&TimeSeriesRow {
             speed_mps: f64::NAN,
             ..sample(1.0)
         }),

@@ -42,14 +42,15 @@ pub struct Kinematics {
     pub steer_rad: f64,
 }
 
-impl Kinematics {
-    /// The planner's view of this state.
-    pub fn to_vehicle_state(&self) -> mergesim_types::VehicleState {
-        mergesim_types::VehicleState {
-            x_m: self.x_m,
-            y_m: self.y_m,
-            yaw_rad: self.yaw_rad,
-            speed_mps: self.speed_mps,
+/// The planner's view of a vehicle's state: the pose and speed of its centre of gravity,
+/// without the velocities, accelerations and angles only the physics knows.
+impl From<&Kinematics> for mergesim_types::VehicleState {
+    fn from(k: &Kinematics) -> Self {
+        Self {
+            x_m: k.x_m,
+            y_m: k.y_m,
+            yaw_rad: k.yaw_rad,
+            speed_mps: k.speed_mps,
         }
     }
 }

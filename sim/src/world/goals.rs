@@ -1,12 +1,13 @@
 //! The vehicles' goals (`crate::goal`), checked every log period, and a vehicle leaving the
 //! map, which ends the run with an event.
 
+use mergesim_types::VehicleState;
 use vehicles::Kinematics;
 
 use super::World;
 use crate::error::SimError;
 use crate::event::SimEvent;
-use crate::goal::{GoalCheck, GoalOutcome};
+use crate::goal::GoalOutcome;
 
 impl World {
     /// Checks the goal of every vehicle that has one and has not reached it yet; logs the
@@ -25,13 +26,7 @@ impl World {
             if slot.is_some() {
                 continue;
             }
-            let at = GoalCheck {
-                t_s,
-                position_m: [k.x_m, k.y_m],
-                heading_rad: k.yaw_rad,
-                speed_mps: k.speed_mps,
-            };
-            if goal.is_reached(&at, &self.lanes) {
+            if goal.is_reached(t_s, &VehicleState::from(k), &self.lanes) {
                 reached_at.push(i);
                 reached.push(SimEvent::GoalReached {
                     t_s,

@@ -2,6 +2,7 @@
 //! and the run's outcome at its end.
 
 use super::*;
+use crate::outcome::TimeSeriesRow;
 
 impl World {
     pub(super) fn log_instant(
@@ -12,18 +13,13 @@ impl World {
     ) -> Result<(), SimError> {
         // Lane changes first (events), then the observers.
         self.log_lane_changes(t_s, kins)?;
-        let samples: Vec<MetricsSample> = kins
+        let samples: Vec<TimeSeriesRow> = self
+            .agents
             .iter()
-            .map(|k| MetricsSample {
-                t_s,
-                x_m: k.x_m,
-                y_m: k.y_m,
-                yaw_rad: k.yaw_rad,
-                yaw_rate_radps: k.yaw_rate_radps,
-                sideslip_rad: k.sideslip_rad,
-                speed_mps: k.speed_mps,
-                accel_long_mps2: k.accel_long_mps2,
-                accel_lat_mps2: k.accel_lat_mps2,
+            .zip(kins)
+            .map(|(a, k)| {
+                let planned_speed_mps = planned_speed_at(&a.path, t_s).unwrap_or(k.speed_mps);
+                TimeSeriesRow::at(t_s, &a.spec.name, k, planned_speed_mps)
             })
             .collect();
         let received: Vec<Vec<SharedLocalPath>> = self
@@ -48,12 +44,10 @@ impl World {
             .enumerate()
             .map(|(i, a)| VehicleView {
                 id: a.id,
-                name: &a.spec.name,
                 kinematics: &kins[i],
                 body: &bodies[i],
                 sample: &samples[i],
                 path: &a.path,
-                planned_speed_mps: planned_speed_at(&a.path, t_s).unwrap_or(kins[i].speed_mps),
                 connected: a.spec.connected,
                 received: &received[i],
             })

@@ -34,15 +34,7 @@ impl World {
             .iter()
             .map(|a| a.vehicle.kinematics(&self.physics))
             .collect();
-        let states: Vec<VehicleState> = kins
-            .iter()
-            .map(|k| VehicleState {
-                x_m: k.x_m,
-                y_m: k.y_m,
-                yaw_rad: k.yaw_rad,
-                speed_mps: k.speed_mps,
-            })
-            .collect();
+        let states: Vec<VehicleState> = kins.iter().map(VehicleState::from).collect();
         let field_due = self.step_index.is_multiple_of(self.steps_per_field);
         // The observation borrows these while the world records events.
         let lanes = std::sync::Arc::clone(&self.lanes);

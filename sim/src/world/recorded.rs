@@ -396,12 +396,7 @@ impl RecordedFleet {
                 let s = m.current?;
                 Some(Neighbour {
                     id: m.id,
-                    state: VehicleState {
-                        x_m: s.position_m[0],
-                        y_m: s.position_m[1],
-                        yaw_rad: s.heading_rad,
-                        speed_mps: s.speed_mps,
-                    },
+                    state: VehicleState::from(&s),
                     shape: m.shape,
                 })
             })
