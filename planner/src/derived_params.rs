@@ -15,7 +15,7 @@
 //! | [`CubicLimits`], [`CubicFitParams`]      | the cubic fit (`cubic_fit`)                              | Eqs. 8–9     |
 //! | [`SpeedOptimiserParams`]                 | the speed optimisation (`speed_optimisation`)            | Eq. 10       |
 //! | [`FollowingParams`]                      | the safe-following cap (`following`)                     | —            |
-//! | [`StopAndGoParams`]                      | stop and go (`stop_and_go`)                              | —            |
+//! | `StopAndGoParams`                      | stop and go (`stop_and_go`)                              | —            |
 //!
 //! The obstacle fields (Eq. 4) keep [`ObstacleFieldParams`] (`PlannerParams::path_field`,
 //! `PlannerParams::interaction_field`). A planner builds all of them once, at construction

@@ -43,7 +43,7 @@ pub mod params;
 pub mod params_tables;
 pub(crate) mod planners;
 pub mod polyline;
-pub(crate) mod potential_field;
+pub mod potential_field;
 pub(crate) mod prediction;
 pub(crate) mod request;
 pub(crate) mod road;

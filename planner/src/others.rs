@@ -202,7 +202,7 @@ fn slot_time_s(horizon: &PlanHorizon, req: &PlanRequest<'_>, i: usize) -> f64 {
 /// fields at their poses at each of the `horizon`'s slot times, against the ego's position
 /// along `line`.
 #[allow(clippy::too_many_arguments)] // the term's inputs, each used once
-pub fn arc_length_term(
+pub(crate) fn arc_length_term(
     horizon: &PlanHorizon,
     field_params: &ObstacleFieldParams,
     rules: RoleRules,
@@ -249,7 +249,7 @@ pub fn arc_length_term(
 /// ego's Eq. 7 waypoint i against each other's pose and speed at slot i, with the interaction
 /// term's fields (`field_params`) and floor ε_I (`floor`).
 #[allow(clippy::too_many_arguments)] // the term's inputs, each used once
-pub fn fixed_waypoint_term(
+pub(crate) fn fixed_waypoint_term(
     horizon: &PlanHorizon,
     field_params: &ObstacleFieldParams,
     floor: f64,

@@ -4,8 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 pub use mergesim_types::{
-    FallbackReason, Neighbour, PathPoint, SharedLocalPath, TimedWaypoint, VehicleId,
-    VehicleShape, VehicleState,
+    FallbackReason, Neighbour, PathPoint, SharedLocalPath, TimedWaypoint, VehicleId, VehicleShape,
+    VehicleState,
 };
 
 /// The output of one planning cycle.

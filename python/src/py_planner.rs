@@ -330,9 +330,9 @@ fn decision(value: &Bound<'_, PyAny>, obs: &Observation<'_>) -> Result<Decision,
         {
             None => None,
             Some(f) if f.is_none() => None,
-            Some(f) => Some(FallbackReason::Other(f.extract::<String>().map_err(|_| {
-                "decision[\"fallback\"]: must be a string or None".to_string()
-            })?)),
+            Some(f) => Some(FallbackReason::Other(f.extract::<String>().map_err(
+                |_| "decision[\"fallback\"]: must be a string or None".to_string(),
+            )?)),
         };
         (path, broadcast, fallback)
     } else {

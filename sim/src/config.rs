@@ -4,7 +4,7 @@ mod driver;
 
 use std::collections::BTreeMap;
 
-use planner::{MergeRoad, PlannerParams, SpeedProfile};
+use planner::{MergeRoad, PlannerParams};
 use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
 

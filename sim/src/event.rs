@@ -6,8 +6,8 @@
 
 use std::fmt;
 
-use mergesim_types::{DegradedMode, FallbackReason};
 use mergesim_types::lanes::LaneId;
+use mergesim_types::{DegradedMode, FallbackReason};
 use serde::{Deserialize, Serialize};
 
 use crate::recording::EventLevel;

@@ -13,8 +13,8 @@ use vehicles::Kinematics;
 
 use crate::error::SimError;
 use crate::event::SimEvent;
-use crate::profile::Phase;
 use crate::outcome::TimeSeriesRow;
+use crate::profile::Phase;
 use crate::safety::BodyState;
 
 /// One vehicle at a logged instant.

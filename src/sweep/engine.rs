@@ -231,7 +231,9 @@ fn check_planner_names(
     }
     for vehicle in &plan.scenario.vehicles {
         match &vehicle.driver {
-            sim::Driver::Planner { name, .. } if plan.planners.is_empty() && !registry.contains(name) => {
+            sim::Driver::Planner { name, .. }
+                if plan.planners.is_empty() && !registry.contains(name) =>
+            {
                 return Err(unknown(name, &format!("vehicle {}", vehicle.name)));
             }
             sim::Driver::Prescribed { path_planner, .. } if !registry.contains(path_planner) => {

@@ -32,8 +32,7 @@ pub mod road;
 pub(crate) mod vehicle;
 
 pub use behaviour::{
-    Behaviour, BehaviourError, Decision, DegradedMode, FallbackReason, Observation,
-    OptimiserReport,
+    Behaviour, BehaviourError, Decision, DegradedMode, FallbackReason, Observation, OptimiserReport,
 };
 pub use bounds::Bound;
 pub use error::InvalidParameter;

@@ -144,7 +144,7 @@ pub struct ScpSettings {
     pub stall_trust_region_mps: f64,
 }
 
-/// Everything [`SpeedOptimiser::solve`] reads besides the [`SpeedProblem`], built once from
+/// Everything `SpeedOptimiser::solve` reads besides the `SpeedProblem`, built once from
 /// `PlannerParams` (`derived_params`; `SpeedOptimiserParams::from(&params)`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpeedOptimiserParams {
@@ -213,7 +213,7 @@ pub(crate) struct SpeedSolution {
 }
 
 /// J(v) of Eq. 10 (module doc), with the non-convex term if given.
-pub fn objective(
+pub(crate) fn objective(
     params: &SpeedObjectiveParams,
     problem: &SpeedProblem<'_>,
     speeds_mps: &[f64],

@@ -233,8 +233,14 @@ mod tests {
     fn a_bad_driver_is_refused_with_what_is_wrong() {
         let cases = [
             ("driver = \"pf-iso\"", "unknown variant `pf-iso`"),
-            ("driver = { planner = \"x\", parms = {} }", "unknown field `parms`"),
-            ("driver = { params = { a = 1 } }", "params go with a planner"),
+            (
+                "driver = { planner = \"x\", parms = {} }",
+                "unknown field `parms`",
+            ),
+            (
+                "driver = { params = { a = 1 } }",
+                "params go with a planner",
+            ),
             (
                 "driver = { planner = \"x\", prescribed = { path_planner = \"x\", speed_profile = [] } }",
                 "not both",
