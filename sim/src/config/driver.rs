@@ -80,12 +80,19 @@ const FORMS: &[&str] = &["planner", "prescribed", "lane-keeping", "idm"];
 /// The keys of a driver table.
 const KEYS: &[&str] = &["planner", "params", "prescribed"];
 
-/// `prescribed = { … }`.
-#[derive(Serialize, Deserialize)]
+/// `prescribed = { … }`, as read.
+#[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct PrescribedForm {
     path_planner: String,
     speed_profile: SpeedProfile,
+}
+
+/// `prescribed = { … }`, as written (borrowing the driver's fields).
+#[derive(Serialize)]
+struct PrescribedRef<'a> {
+    path_planner: &'a str,
+    speed_profile: &'a SpeedProfile,
 }
 
 impl Serialize for Driver {
@@ -106,9 +113,9 @@ impl Serialize for Driver {
                 let mut map = serializer.serialize_map(Some(1))?;
                 map.serialize_entry(
                     "prescribed",
-                    &PrescribedForm {
-                        path_planner: path_planner.clone(),
-                        speed_profile: speed_profile.clone(),
+                    &PrescribedRef {
+                        path_planner,
+                        speed_profile,
                     },
                 )?;
                 map.end()
