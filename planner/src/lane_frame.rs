@@ -9,8 +9,6 @@
 //! of a uniformly sampled arc, ∇s = t(s) and ∇d = n(s); at an offset d on a curve of curvature κ,
 //! |∇s| = 1/(1 − κd); on a straight lane, ∇s = (1, 0) and ∇d = (0, 1) rotated with the lane.
 
-use std::f64::consts::PI;
-
 use mergesim_types::lanes::{Centreline, FrameAxes, FramePoint};
 
 /// A world point's place in a lane frame with the world gradients of s and d there.
@@ -55,19 +53,13 @@ pub(crate) fn to_world_gradient(j: &FrameJacobian, du_ds: f64, du_dd: f64) -> [f
     ]
 }
 
-/// Wraps an angle to (−π, π] (rad).
-pub(crate) fn wrap_rad(a: f64) -> f64 {
-    let w = (a + PI).rem_euclid(2.0 * PI) - PI;
-    if w == -PI { PI } else { w }
-}
-
-/// A vehicle's heading relative to the lane at its position (rad, in (−π, π]): its world yaw
+/// A vehicle's heading relative to the lane at its position (rad, in [−π, π)): its world yaw
 /// minus the lane's smoothed heading at the vehicle's s. Eq. 4's ψ_o on a curved road: a
 /// vehicle following the lane has 0 here whatever the map's orientation, so a rotated map gives
 /// the same obstacle field. On a straight road along +x it is the world yaw.
 pub fn lane_relative_heading_rad(centreline: &Centreline, p_m: [f64; 2], yaw_rad: f64) -> f64 {
     let s = centreline.project(p_m).s_m;
-    wrap_rad(yaw_rad - centreline.heading_rad(s))
+    mergesim_types::angle::wrap_angle_rad(yaw_rad - centreline.heading_rad(s))
 }
 
 /// A path given in a lane frame as d(s), at one s: its offset and two derivatives.
@@ -129,6 +121,7 @@ mod tests {
     use super::*;
     use mergesim_types::lanes::{LaneRoad, THROUGH_LANE_ID, curved_merge_spec};
     use mergesim_types::road::MergeRoad;
+    use std::f64::consts::PI;
 
     fn arc_road() -> LaneRoad {
         LaneRoad::new(&curved_merge_spec(&MergeRoad::default(), 300.0).unwrap()).unwrap()
@@ -176,7 +169,6 @@ mod tests {
             assert!((lane_relative_heading_rad(c, p, h - 3.0) + 3.0).abs() < 1e-9);
             assert!((lane_relative_heading_rad(c, p, h + 2.0 * PI) - 0.0).abs() < 1e-9);
         }
-        assert!((wrap_rad(-PI) - PI).abs() < 1e-15);
     }
 
     #[test]

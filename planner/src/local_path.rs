@@ -18,6 +18,7 @@
 //! integrator with step-size control, which leaves the path unchanged where the field is smooth.
 
 use crate::potential_field::PotentialField;
+use mergesim_types::angle::wrap_angle_rad;
 
 /// N waypoints (world frame) from `start_xy_m`, each `step_m` of path length after the
 /// previous one, following F_uni with the moving target. With `time_per_step_s` > 0 the
@@ -92,8 +93,7 @@ pub(crate) fn local_path_adaptive(
                 };
                 let elapsed_s = (k as f64 + along) * time_per_step_s;
                 let psi_q = direction(field.stepping_force_at(q[0], q[1], elapsed_s));
-                let turn = (psi_q - psi + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-                    - std::f64::consts::PI;
+                let turn = wrap_angle_rad(psi_q - psi);
                 // NaN turns are accepted: the caller checks the waypoints for finiteness.
                 if turn.abs() > max_turn_rad && length > h_min {
                     substep = (0.5 * length).max(h_min);

@@ -262,9 +262,8 @@ impl ObstacleField {
 }
 
 fn cap_heading(heading_rad: f64) -> f64 {
-    let wrapped = (heading_rad + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-        - std::f64::consts::PI;
-    wrapped.clamp(-MAX_CORRELATION_HEADING_RAD, MAX_CORRELATION_HEADING_RAD)
+    mergesim_types::angle::wrap_angle_rad(heading_rad)
+        .clamp(-MAX_CORRELATION_HEADING_RAD, MAX_CORRELATION_HEADING_RAD)
 }
 
 #[cfg(test)]

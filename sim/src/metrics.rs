@@ -252,16 +252,6 @@ fn integral_abs_linear(r0: f64, r1: f64, dt_s: f64) -> f64 {
     }
 }
 
-/// Wraps an angle to (−π, π].
-fn wrap_angle_rad(angle_rad: f64) -> f64 {
-    let wrapped = angle_rad.sin().atan2(angle_rad.cos());
-    if wrapped <= -std::f64::consts::PI {
-        std::f64::consts::PI
-    } else {
-        wrapped
-    }
-}
-
 /// Running metrics of one vehicle.
 #[derive(Clone, Debug)]
 pub struct VehicleMetrics {
@@ -379,7 +369,9 @@ impl VehicleMetrics {
             self.max_abs_sideslip_rad = s.sideslip_rad.abs();
             self.t_max_abs_sideslip_s = s.t_s;
         }
-        self.max_abs_yaw_rad = self.max_abs_yaw_rad.max(wrap_angle_rad(s.yaw_rad).abs());
+        self.max_abs_yaw_rad = self
+            .max_abs_yaw_rad
+            .max(mergesim_types::angle::wrap_angle_rad(s.yaw_rad).abs());
         if s.yaw_rate_radps.abs() > self.max_abs_yaw_rate_radps || self.samples == 0 {
             self.max_abs_yaw_rate_radps = s.yaw_rate_radps.abs();
             self.t_max_abs_yaw_rate_s = s.t_s;
@@ -495,14 +487,5 @@ mod tests {
         assert!((integral_abs_linear(-1.0, 1.0, 2.0) - 1.0).abs() < 1e-12);
         // Crossing at a quarter: triangles ½·0.5·1 + ½·1.5·3.
         assert!((integral_abs_linear(1.0, -3.0, 2.0) - (0.25 + 2.25)).abs() < 1e-12);
-    }
-
-    #[test]
-    fn wrap_angle_is_in_half_open_interval() {
-        use std::f64::consts::PI;
-        assert!((wrap_angle_rad(3.0 * PI) - PI).abs() < 1e-12);
-        assert!((wrap_angle_rad(-PI) - PI).abs() < 1e-12);
-        assert!((wrap_angle_rad(2.0 * PI + 0.3) - 0.3).abs() < 1e-12);
-        assert!((wrap_angle_rad(-0.3) + 0.3).abs() < 1e-12);
     }
 }

@@ -15,15 +15,10 @@
 //! whole run and stands still at that state's position and heading: speed 0, whatever its
 //! recorded time and speed.
 
-use std::f64::consts::{PI, TAU};
+use mergesim_types::angle::wrap_angle_rad;
 
 use crate::error::SimError;
 use crate::recorded_traffic::{RecordedState, RecordedTraffic, RecordedVehicle};
-
-/// `angle_rad` wrapped into [−π, π).
-pub fn wrap_angle_rad(angle_rad: f64) -> f64 {
-    (angle_rad + PI).rem_euclid(TAU) - PI
-}
 
 impl RecordedVehicle {
     /// Its state at time `t_s` (module doc); `None` outside its recorded span.

@@ -16,10 +16,12 @@
 //!   [`Decision`] (with [`DegradedMode`], [`OptimiserReport`], [`BehaviourError`]).
 //! - A sampling grid [`GridSpec`] (at most [`MAX_GRID_CELLS`] cells), a parameter's range
 //!   [`Bound`] ([`bounds`]) and the error for a value out of range, [`InvalidParameter`].
-//! - Helpers: [`files::read_regular_text`], [`percentile::nearest_rank_percentile`] and the
+//! - Helpers: [`angle::wrap_angle_rad`] (the one angle wrap), [`files::read_regular_text`],
+//!   [`percentile::nearest_rank_percentile`] and the
 //!   merge road's limits in [`road`].
 #![warn(missing_docs)]
 
+pub mod angle;
 pub(crate) mod behaviour;
 pub mod bounds;
 pub(crate) mod error;

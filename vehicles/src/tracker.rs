@@ -363,15 +363,6 @@ fn walk(path: &[mergesim_types::PathPoint], segment: usize, t: f64, distance_m: 
     }
 }
 
-fn wrap_angle(a: f64) -> f64 {
-    let two_pi = std::f64::consts::TAU;
-    let mut w = a.rem_euclid(two_pi);
-    if w > std::f64::consts::PI {
-        w -= two_pi;
-    }
-    w
-}
-
 impl Tracker {
     /// A tracker for a car with these parameters (see [`TrackerParams::validate`]).
     pub fn new(params: TrackerParams, vehicle: &VehicleParams) -> Self {
@@ -442,7 +433,7 @@ impl Tracker {
         let target = walk(path, seg, t, lookahead);
         let (dx, dy) = (target[0] - rear[0], target[1] - rear[1]);
         let distance = dx.hypot(dy).max(1e-3);
-        let alpha = wrap_angle(dy.atan2(dx) - kin.yaw_rad);
+        let alpha = mergesim_types::angle::wrap_angle_rad(dy.atan2(dx) - kin.yaw_rad);
         let steer = (2.0 * self.wheelbase_m * alpha.sin() / distance).atan();
 
         // Speed: the path point nearest ahead of the CoG.

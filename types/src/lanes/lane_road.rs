@@ -89,11 +89,6 @@ pub struct LaneRoad {
     pub(crate) lane_ends: Vec<LaneEnd>,
 }
 
-/// |a − b| wrapped to [0, π].
-fn angle_between(a: f64, b: f64) -> f64 {
-    ((a - b + PI).rem_euclid(2.0 * PI) - PI).abs()
-}
-
 fn check_tolerances(t: &LaneTolerances) -> Result<(), LaneError> {
     let bad = |field, value, reason| {
         Err(LaneError::BadTolerance {
@@ -262,7 +257,8 @@ impl LaneRoad {
                     fp.s_m >= -tol
                         && fp.s_m <= nb.length_m() + tol
                         && (fp.d_m - nb.bound_d_m(other_side, fp.s_m)).abs() <= tol
-                        && angle_between(l.heading_rad(s), nb.heading_rad(fp.s_m)) < 0.5 * PI
+                        && crate::angle::angle_between_rad(l.heading_rad(s), nb.heading_rad(fp.s_m))
+                            < 0.5 * PI
                 });
                 if !beside {
                     return Err(LaneError::NeighbourNotBeside {
