@@ -148,11 +148,16 @@ fn plan_cycle(c: &mut Criterion) {
         .collect();
     // The defaults (the Newton QP, the SCP iterated to convergence: at most 20 iterations,
     // stalled below a 1 cm/s trust region; docs/parameters.md), the cone program iterated the
-    // same way, and the defaults before 2026-12-02 (the cone program, two SCP iterations).
-    let with = |program: SpeedProgram, max_scp_iterations: usize, stall_mps: f64| PlannerParams {
+    // same way, the defaults without the step-size stop (before 2026-12-03), and the defaults
+    // before 2026-12-02 (the cone program, two SCP iterations).
+    let with = |program: SpeedProgram,
+                max_scp_iterations: usize,
+                stall_mps: f64,
+                step_tolerance_mps: f64| PlannerParams {
         speed_program: program,
         max_scp_iterations,
         scp_stall_trust_region_mps: stall_mps,
+        scp_step_tolerance_mps: step_tolerance_mps,
         ..planner.params().clone()
     };
     for (name, params) in [
@@ -162,11 +167,15 @@ fn plan_cycle(c: &mut Criterion) {
         ),
         (
             "pf_iso_plan_cycle_n20_one_neighbour_moving_cone",
-            with(SpeedProgram::Cone, 20, 0.01),
+            with(SpeedProgram::Cone, 20, 0.01, 0.01),
+        ),
+        (
+            "pf_iso_plan_cycle_n20_one_neighbour_moving_no_step_stop",
+            with(SpeedProgram::NewtonQp, 20, 0.01, 0.0),
         ),
         (
             "pf_iso_plan_cycle_n20_one_neighbour_moving_cone_two_iterations",
-            with(SpeedProgram::Cone, 2, 0.0),
+            with(SpeedProgram::Cone, 2, 0.0, 0.0),
         ),
     ] {
         // A fresh planner on the road already prepared (as a simulation builds its planners

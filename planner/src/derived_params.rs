@@ -174,6 +174,7 @@ impl From<&PlannerParams> for ScpSettings {
             max_iterations: p.max_scp_iterations,
             relative_tolerance: p.scp_relative_tolerance,
             stall_trust_region_mps: p.scp_stall_trust_region_mps,
+            step_tolerance_mps: p.scp_step_tolerance_mps,
         }
     }
 }

@@ -205,6 +205,11 @@ pub struct PlannerParams {
     /// defaults (20 iterations, 0.01 m/s) the cap binds in under 1 % of the planning cycles of
     /// every built-in scenario (docs/parameters.md).
     pub scp_stall_trust_region_mps: f64,
+    /// SCP stops (converged) when the convex subproblem's step is this small: every speed of
+    /// its solution within this of the iterate (m/s); 0: never. Its value equals
+    /// `scp_stall_trust_region_mps`, the radius the SCP already treats as no further progress
+    /// (criterion in docs/parameters.md).
+    pub scp_step_tolerance_mps: f64,
     /// Bound consecutive speeds by |v_{i+1} − v_i| ≤ a_max · Δt_plan (and v_1 against the
     /// current speed when that is feasible).
     pub accel_bound_enabled: bool,
@@ -335,6 +340,7 @@ impl Default for PlannerParams {
             max_scp_iterations: 20,
             scp_relative_tolerance: 1e-4,
             scp_stall_trust_region_mps: 0.01,
+            scp_step_tolerance_mps: 0.01,
             accel_bound_enabled: true,
             max_accel_mps2: 3.0,
             jerk_bound_enabled: false,
@@ -412,6 +418,7 @@ pub const PLANNER_BOUNDS: &[Bound] = &[
     Bound::closed("max_scp_iterations", 1.0, 50.0, ""),
     Bound::closed("scp_relative_tolerance", 0.0, 1.0, ""),
     Bound::closed("scp_stall_trust_region_mps", 0.0, 50.0, "m/s"),
+    Bound::closed("scp_step_tolerance_mps", 0.0, 50.0, "m/s"),
     Bound::above("max_accel_mps2", 0.0, 20.0, "m/s²"),
     Bound::above("max_jerk_mps3", 0.0, 100.0, "m/s³"),
     Bound::closed("solver_max_iterations", 0.0, 1000.0, ""),
@@ -481,6 +488,7 @@ impl PlannerParams {
                 "scp_stall_trust_region_mps",
                 self.scp_stall_trust_region_mps,
             ),
+            ("scp_step_tolerance_mps", self.scp_step_tolerance_mps),
             ("max_accel_mps2", self.max_accel_mps2),
             ("max_jerk_mps3", self.max_jerk_mps3),
             (

@@ -93,6 +93,7 @@ pub const ALL_FIELDS: &[&str] = &[
     "max_scp_iterations",
     "scp_relative_tolerance",
     "scp_stall_trust_region_mps",
+    "scp_step_tolerance_mps",
     "accel_bound_enabled",
     "max_accel_mps2",
     "jerk_bound_enabled",

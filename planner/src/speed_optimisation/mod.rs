@@ -47,7 +47,10 @@
 //! cone program is solved inside the trust region |v_i − v̄_i| ≤ ρ, and the step d = v* − v̄
 //! to its solution v* is shortened by a backtracking line search on the true J (t = 1, ½, ¼, …
 //! until J(v̄ + t d) ≤ J(v̄) + ¼ t ∇J(v̄)ᵀd, see `ARMIJO_FRACTION`; ρ is halved when t < 1
-//! or no t passes); iterations stop when J stops falling or after `max_scp_iterations` solves. The linearised
+//! or no t passes); iterations stop when J stops falling, when the subproblem's step d is
+//! within `scp_step_tolerance_mps` of zero in every speed (converged: the warm start was
+//! already optimal), when no t passes with ρ below `scp_stall_trust_region_mps` (stalled), or
+//! after `max_scp_iterations` solves. The linearised
 //! interaction has no curvature, so v* usually sits on the trust-region boundary; kept whole
 //! (or rejected, the only alternative), the step could only move by ρ, ρ/2, …, and when the
 //! minimum lies between v̄ and v̄ ± ρ/2 successive planning cycles (each one warm-started at
@@ -142,6 +145,9 @@ pub struct ScpSettings {
     /// Stop, stalled, when no descent step is found and ρ is below this (m/s;
     /// `scp_stall_trust_region_mps`).
     pub stall_trust_region_mps: f64,
+    /// Stop, converged, when the subproblem's solution lies within this of the iterate in every
+    /// speed (m/s; `scp_step_tolerance_mps`; 0: never).
+    pub step_tolerance_mps: f64,
 }
 
 /// Everything `SpeedOptimiser::solve` reads besides the `SpeedProblem`, built once from

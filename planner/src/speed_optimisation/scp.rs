@@ -266,6 +266,17 @@ impl SpeedOptimiser {
             }
             // Backtracking (Armijo) line search along d = candidate − v̄ on the true J.
             let d: Vec<f64> = candidate.iter().zip(&v).map(|(c, vi)| c - vi).collect();
+            let step_mps = d.iter().fold(0.0_f64, |m, di| m.max(di.abs()));
+            if params.scp.step_tolerance_mps > 0.0 && step_mps <= params.scp.step_tolerance_mps {
+                // The subproblem barely moves the iterate: converged. Its solution is kept when
+                // it does not raise J (for the Newton QP, the last Newton step).
+                if jc.is_finite() && jc <= j {
+                    v = candidate;
+                    j = jc;
+                }
+                stopped_at_iteration_cap = false;
+                break;
+            }
             let slope: f64 = (0..n)
                 .map(|i| (smooth_gradient(weights, problem, i, v[i]) + g[i]) * d[i])
                 .sum();
@@ -441,6 +452,51 @@ mod tests {
         let exact = solve(SpeedProgram::Cone, 1);
         assert_eq!(exact.solves, 1);
         assert!(!exact.stopped_at_iteration_cap);
+    }
+
+    /// A warm start already at the optimum: the step-size stop ends the SCP after one solve;
+    /// without it (`scp_step_tolerance_mps = 0`, and no relative-decrease stop) the SCP goes on
+    /// solving for steps it cannot take. Both give the same speeds.
+    #[test]
+    fn a_warm_start_at_the_optimum_stops_after_one_solve() {
+        let segment_lengths_m: Vec<f64> = (0..12).map(|i| 3.0 + 0.5 * i as f64).collect();
+        let max_speeds_mps = vec![30.0; 12];
+        let params = |step_tolerance_mps: f64| PlannerParams {
+            travel_time_weight: 40.0,
+            speed_deviation_weight: 0.8,
+            scp_step_tolerance_mps: step_tolerance_mps,
+            scp_relative_tolerance: 0.0,
+            ..unbounded_params()
+        };
+        let cold = SpeedProblem {
+            current_speed_mps: 15.0,
+            target_speed_mps: 15.0,
+            segment_lengths_m: &segment_lengths_m,
+            max_speeds_mps: &max_speeds_mps,
+            initial_guess_mps: None,
+            interaction: None,
+            interaction_weight: 0.0,
+        };
+        let optimum = SpeedOptimiser::new()
+            .solve(&(&params(0.0)).into(), &cold)
+            .unwrap()
+            .speeds_mps;
+        let warm = SpeedProblem {
+            initial_guess_mps: Some(&optimum),
+            ..cold
+        };
+        let with_stop = SpeedOptimiser::new()
+            .solve(&(&params(0.01)).into(), &warm)
+            .unwrap();
+        let without = SpeedOptimiser::new()
+            .solve(&(&params(0.0)).into(), &warm)
+            .unwrap();
+        assert_eq!(with_stop.solves, 1);
+        assert!(!with_stop.stopped_at_iteration_cap);
+        assert!(without.solves > 5, "{}", without.solves);
+        for (a, b) in with_stop.speeds_mps.iter().zip(&without.speeds_mps) {
+            assert!((a - b).abs() < 1e-6, "{a} vs {b}");
+        }
     }
 
     #[test]
