@@ -216,23 +216,37 @@ fn planner_stats_count_the_optimisers_solves_and_capped_cycles() {
     );
 }
 
-/// `scp_stall_trust_region_mps`: the cycles that run to a high cap without the stall test are
-/// cycles whose line search finds no descent (the trust region halving away); with it they stop
-/// early as stalled, not capped, and the plans are the same to the solver's accuracy.
+/// `scp_stall_trust_region_mps` (with the step-size stop off): the cycles that run to a high
+/// cap without the stall test are cycles whose line search finds no descent (the trust region
+/// halving away); with it they stop early as stalled, not capped, and the plans are the same to
+/// the solver's accuracy. `scp_step_tolerance_mps` (the default) then ends most of those cycles
+/// after one solve instead of the halvings down to the stall radius.
 #[test]
 fn the_stall_test_separates_stalled_from_capped_cycles() {
     let scenario = Scenario::load("urgent_merge").unwrap();
-    let with = |stall_mps: f64| {
+    let with = |stall_mps: f64, step_tolerance_mps: f64| {
         let mut s = scenario.clone();
         s.sim.planner.max_scp_iterations = 20;
         s.sim.planner.scp_stall_trust_region_mps = stall_mps;
+        s.sim.planner.scp_step_tolerance_mps = step_tolerance_mps;
         run(&s, Some(PlannerKind::PfIso), false)
     };
-    let without = with(0.0);
-    let stalled = with(0.01);
+    let without = with(0.0, 0.0);
+    let stalled = with(0.01, 0.0);
+    let step_stop = with(0.01, 0.01);
     assert!(without.planner_stats.optimiser_iteration_cap_cycles > 0);
     assert_eq!(stalled.planner_stats.optimiser_iteration_cap_cycles, 0);
     assert!(stalled.planner_stats.optimiser_solves < without.planner_stats.optimiser_solves);
+    assert_eq!(step_stop.planner_stats.optimiser_iteration_cap_cycles, 0);
+    // Measured 2026-12-03: 1,009 solves with the stall test alone, 530 with the step stop.
+    assert!(
+        (step_stop.planner_stats.optimiser_solves as f64)
+            < 0.75 * stalled.planner_stats.optimiser_solves as f64,
+        "{} vs {}",
+        step_stop.planner_stats.optimiser_solves,
+        stalled.planner_stats.optimiser_solves
+    );
     let gap = |o: &mergesim::sim::RunOutcome| o.safety.min_gap_m.unwrap_or(f64::INFINITY);
     assert!((gap(&without) - gap(&stalled)).abs() < 1e-3);
+    assert!((gap(&stalled) - gap(&step_stop)).abs() < 1e-3);
 }
