@@ -188,8 +188,8 @@ pub fn std_derivative(
     };
     let fz_f = m * (-a * p.sprung_cog_height_m + g * lr) / wheelbase_m;
     let fz_r = m * (a * p.sprung_cog_height_m + g * lf) / wheelbase_m;
-    let u_wf = (v * beta.cos() * delta.cos() + (v * beta.sin() + lf * psi_dot) * delta.sin())
-        .max(0.0);
+    let u_wf =
+        (v * beta.cos() * delta.cos() + (v * beta.sin() + lf * psi_dot) * delta.sin()).max(0.0);
     let u_wr = (v * beta.cos()).max(0.0);
     let s_f = 1.0 - rw * omega_f / u_wf.max(v_hat);
     let s_r = 1.0 - rw * omega_r / u_wr.max(v_hat);

@@ -41,6 +41,7 @@ pub mod ks;
 pub mod params;
 pub mod st;
 pub mod tire;
+pub mod validation;
 
 pub use constraints::{
     CommonRoadInput, constrain_acceleration, constrain_input, constrain_steering_velocity,
@@ -49,7 +50,8 @@ pub use drift::{StdState, std_derivative, std_dynamic_weight, std_step_rk4};
 pub use integrate::{CommonRoadState, step_rk4};
 pub use ks::{KsState, ks_cog_derivative, ks_derivative, ks_step_rk4};
 pub use params::{
-    CommonRoadLongitudinalLimits, CommonRoadParamsError, CommonRoadSteeringLimits,
-    CommonRoadTireParams, CommonRoadVehicleParams,
+    CommonRoadLongitudinalLimits, CommonRoadSteeringLimits, CommonRoadTireParams,
+    CommonRoadVehicleParams,
 };
 pub use st::{StState, st_derivative, st_step_rk4};
+pub use validation::CommonRoadParamsError;

@@ -99,7 +99,8 @@ mod tests {
         let t = CommonRoadTireParams::default();
         let fz = 3000.0;
         let h = 1e-7;
-        let ky = (pure_lateral_force_n(h, fz, &t).0 - pure_lateral_force_n(-h, fz, &t).0) / (2.0 * h);
+        let ky =
+            (pure_lateral_force_n(h, fz, &t).0 - pure_lateral_force_n(-h, fz, &t).0) / (2.0 * h);
         assert!((ky - t.p_ky1 * fz).abs() < 1e-4 * fz, "{ky}");
         // The longitudinal curve is evaluated at −s, so its slope in s is −K_x (shifts are tiny:
         // p_hx1 moves the point of evaluation, which costs a little slope).
