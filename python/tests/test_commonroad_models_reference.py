@@ -1,20 +1,25 @@
 """The fixture of the Rust CommonRoad-model tests (tests/data/commonroad_models/reference.json)
 is what commonroad-vehicle-models 3.0.2 computes today: recomputed here by
 scripts/commonroad_models_reference.py with the installed package, so that the fixture is
-checked against the package rather than against itself. Skipped where the package is not
-installed (`pip install commonroad-vehicle-models==3.0.2`)."""
+checked against the package rather than against itself. The package comes with commonroad-io
+(python/ci.sh pins commonroad-io, which requires commonroad-vehicle-models >= 2.0.0); skipped
+where it is missing or another version than the fixture's 3.0.2
+(`pip install commonroad-vehicle-models==3.0.2`)."""
 
 from __future__ import annotations
 
 import importlib.util
 import json
 import math
+from importlib import metadata
 
 import pytest
 
 from conftest import REPO
 
 pytest.importorskip("vehiclemodels")
+if metadata.version("commonroad-vehicle-models") != "3.0.2":
+    pytest.skip("the fixture is for commonroad-vehicle-models 3.0.2", allow_module_level=True)
 
 SCRIPT = REPO / "scripts" / "commonroad_models_reference.py"
 FIXTURE = REPO / "tests" / "data" / "commonroad_models" / "reference.json"

@@ -13,9 +13,11 @@
 //! resolves the inputs is fine. The st model's sideslip and yaw modes scale as 1/v: with the
 //! BMW 320i, λ ≈ −μ·C_S·g / v ≈ −215 s⁻¹·(1 m/s)/v, so h = 0.01 s is stable above about
 //! 0.8 m/s and h = 1 ms down to its switch to the kinematic model at 0.1 m/s. The std model's
-//! wheel spin modes are stiffer: λ ≈ −R_w²·K_x / (I_w·u_w) with the tyre's slip stiffness
-//! K_x = p_kx1·F_z, about −7700 s⁻¹·(1 m/s)/u_w for the BMW, so h = 1 ms needs u_w ≳ 3 m/s and
-//! the crawl to a stop needs h ≈ 0.1 ms (CommonRoad's own examples use a stiff adaptive solver).
+//! wheel-spin modes are stiffer: near free rolling λ ≈ −R_w²·K_x / (I_w·u_w) with the tyre's
+//! slip stiffness K_x = p_kx1·F_z, for the BMW about −7500 s⁻¹ (rear) to −9200 s⁻¹ (front)
+//! times (1 m/s)/u_w, so h = 1 ms needs wheel ground speeds above about 3.3 m/s; the reference
+//! manoeuvres that crawl to a stop run at h = 0.1 ms. (CommonRoad's own examples use a stiff
+//! adaptive solver.)
 
 /// A state that the integrator can handle as `N` numbers in CommonRoad's order.
 pub trait CommonRoadState<const N: usize>: Copy {
