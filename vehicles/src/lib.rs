@@ -24,9 +24,12 @@
 //!   [`ManeuverReport`], compared with the linear single-track model [`LinearSingleTrack`]
 //!   ([`linear_yaw_rate_radps`]).
 //! - Errors: [`VehicleError`].
+//! - CommonRoad's vehicle models ks, st and std as pure functions (no rapier), with their
+//!   parameter sets and an RK4 step: [`commonroad_models`].
 #![warn(missing_docs)]
 
 pub mod collision_groups;
+pub mod commonroad_models;
 pub(crate) mod controls;
 pub(crate) mod error;
 pub(crate) mod kinematic_body;
