@@ -38,4 +38,4 @@ pub mod study;
 pub mod summary;
 pub mod sweep;
 
-pub use {planner, scenarios, sim, vehicles};
+pub use {mergesim_types, planner, scenarios, sim, vehicles};

@@ -216,9 +216,10 @@ impl RunSummary {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mergesim_types::Lane;
     use sim::recorded_traffic::{RecordedState, RecordedTraffic, RecordedVehicle, TrafficMode};
     use sim::recording::Recorder;
-    use sim::{Driver, Lane, RunOptions, SimConfig, VehicleSpec, World};
+    use sim::{Driver, RunOptions, SimConfig, VehicleSpec, World};
 
     /// A recorded car running into a lane-keeping car from behind (as in
     /// `sim/tests/recorded_traffic.rs`): the summary counts it apart.

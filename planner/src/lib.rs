@@ -41,28 +41,29 @@ pub mod others;
 pub(crate) mod parameter_set;
 pub mod params;
 pub mod params_tables;
+mod plan;
+mod planner_kind;
 pub(crate) mod planners;
 pub mod polyline;
 pub mod potential_field;
 pub(crate) mod prediction;
 pub(crate) mod request;
-pub(crate) mod road;
 pub mod road_field;
 pub mod speed_optimisation;
 pub mod speed_profile;
 pub(crate) mod stop_and_go;
-pub(crate) mod types;
 
 pub use error::PlannerError;
 pub use following::V2vLossFallback;
 pub use parameter_set::ParameterSet;
 pub use params::{PlannerParams, SlpReading};
-pub use planners::{PfPlanner, PlanRequest, PlanStats, PlannerKind};
+pub use plan::Plan;
+pub use planner_kind::PlannerKind;
+pub use planners::{PfPlanner, PlanStats};
 pub use potential_field::PotentialField;
-pub use road::{Lane, MergeRoad};
+pub use request::PlanRequest;
 pub use speed_optimisation::SpeedProgram;
 pub use speed_profile::SpeedProfile;
-pub use types::*;
 
 /// The README's examples, compiled and run as doc tests.
 #[doc = include_str!("../README.md")]

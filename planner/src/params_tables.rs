@@ -14,7 +14,7 @@
 //! A planner accepts the keys of `pf` and of its own table ([`tables_of`]); a key of another
 //! planner's table is refused naming that table ([`check_key`]).
 
-use crate::planners::PlannerKind;
+use crate::planner_kind::PlannerKind;
 
 /// The table every PF planner reads (today's `[sim.planner]`, kept as its alias).
 pub const PF_TABLE: &str = "pf";

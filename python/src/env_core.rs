@@ -163,7 +163,7 @@ impl EnvCore {
                 Arc::new(move |_: &sim::FactoryInput<'_>| {
                     Ok(Box::new(External {
                         command: shared.clone(),
-                    }) as Box<dyn sim::Behaviour>)
+                    }) as Box<dyn mergesim_types::Behaviour>)
                 }),
             )
             .map_err(|e| BindingError::input(&e))?;
@@ -201,11 +201,12 @@ impl EnvCore {
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner) = Command {
             target_speed_mps: agent_spec.target_speed_mps,
-            target_y_m: instance
-                .sim
-                .road
-                .lane_center_y_m(agent_spec.lane.merge_lane().unwrap_or(sim::Lane::Lower))
-                + agent_spec.y_offset_m,
+            target_y_m: instance.sim.road.lane_center_y_m(
+                agent_spec
+                    .lane
+                    .merge_lane()
+                    .unwrap_or(mergesim_types::Lane::Lower),
+            ) + agent_spec.y_offset_m,
         };
         *self
             .contacts

@@ -4,7 +4,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use planner::{Lane, ParameterSet, PlannerParams};
+use mergesim_types::Lane;
+use planner::{ParameterSet, PlannerParams};
 use serde::{Deserialize, Serialize};
 use sim::{SimConfig, SimError, VehicleSpec};
 use thiserror::Error;

@@ -5,9 +5,10 @@
 
 use std::sync::Arc;
 
+use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
 use scenarios::{Scenario, ScenarioError};
 use sim::registry::{BehaviourRegistry, FactoryInput};
-use sim::{Behaviour, BehaviourError, Decision, Observation, ParamsError, PlannerParameters};
+use sim::{ParamsError, PlannerParameters};
 
 const URGENT: &str = include_str!("../builtin/urgent_merge.toml");
 const EGO_DRIVER: &str = "driver = { planner = \"pf-iso\" }";

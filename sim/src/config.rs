@@ -4,7 +4,8 @@ mod driver;
 
 use std::collections::BTreeMap;
 
-use planner::{MergeRoad, PlannerParams};
+use mergesim_types::MergeRoad;
+use planner::PlannerParams;
 use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
 

@@ -53,12 +53,6 @@ pub(crate) mod world;
 pub use config::{Driver, SimConfig, VehicleSpec, validate_vehicles};
 pub use error::SimError;
 pub use event::SimEvent;
-/// Roads made of lanes (what `Observation::lanes` is): re-exported for planners written against
-/// the simulator.
-pub use mergesim_types::lanes;
-pub use mergesim_types::{
-    Behaviour, BehaviourError, Decision, Lane, MergeRoad, Observation, PathPoint, VehicleId,
-};
 pub use observer::{PlanView, TickObserver, VehicleView};
 pub use outcome::{PlannerStats, RecordedPose, RunOutcome, TimeSeriesRow};
 pub use planner_params::{ParamsError, ParamsTable, PlannerParameters};

@@ -7,14 +7,14 @@
 //! ```
 //! use std::sync::Arc;
 //! use sim::registry::{BehaviourRegistry, FactoryInput};
-//! use sim::{Behaviour, BehaviourError, Decision, Observation};
+//! use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
 //!
 //! struct Cruise;
 //! impl Behaviour for Cruise {
 //!     fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError> {
 //!         let v = obs.target_speed_mps;
 //!         let path = (0..=10)
-//!             .map(|i| sim::PathPoint {
+//!             .map(|i| mergesim_types::PathPoint {
 //!                 x_m: obs.ego.x_m + 5.0 * i as f64,
 //!                 y_m: obs.ego.y_m,
 //!                 speed_mps: v,
@@ -42,7 +42,8 @@
 //! ```
 //! use std::sync::Arc;
 //! use sim::registry::{BehaviourRegistry, FactoryInput};
-//! use sim::{Behaviour, BehaviourError, Decision, Observation, ParamsError, PlannerParameters};
+//! use sim::{ParamsError, PlannerParameters};
+//! use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
 //!
 //! #[derive(Debug, Default, serde::Deserialize)]
 //! #[serde(deny_unknown_fields, default)]

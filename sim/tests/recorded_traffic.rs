@@ -5,12 +5,12 @@
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
+use mergesim_types::{Behaviour, BehaviourError, Decision, Lane, Observation, VehicleId};
 use sim::idm::{IdmParams, desired_gap_m};
 use sim::recorded_traffic::{RecordedState, RecordedTraffic, RecordedVehicle, TrafficMode};
 use sim::recording::Recorder;
 use sim::{
-    Behaviour, BehaviourError, BehaviourRegistry, Decision, Driver, FactoryInput, Lane,
-    Observation, RunOptions, RunOutcome, SimConfig, VehicleId, VehicleSpec, World,
+    BehaviourRegistry, Driver, FactoryInput, RunOptions, RunOutcome, SimConfig, VehicleSpec, World,
 };
 
 /// Upper lane centre of the default merge road (m).
