@@ -7,7 +7,8 @@ use std::time::Instant;
 
 use scenarios::Scenario;
 use sim::recording::Recorder;
-use sim::{BehaviourRegistry, RunOptions, RunOutcome, SimError, World};
+use sim::registry::BehaviourRegistry;
+use sim::{RunOptions, RunOutcome, SimError, World};
 use thiserror::Error;
 
 use crate::summary::RunSummary;
@@ -68,7 +69,7 @@ pub fn planner_label(scenario: &Scenario, planner: Option<&str>) -> String {
         .vehicles
         .iter()
         .filter_map(|v| match &v.driver {
-            sim::Driver::Planner { name, .. } => Some(name.as_str()),
+            sim::config::Driver::Planner { name, .. } => Some(name.as_str()),
             _ => None,
         })
         .collect();

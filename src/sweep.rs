@@ -38,7 +38,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::atomic::Ordering;
 
 use scenarios::Scenario;
-use sim::BehaviourRegistry;
+use sim::registry::BehaviourRegistry;
 use sim::rng::SplitMix64;
 
 use thiserror::Error;

@@ -172,7 +172,7 @@ fn max_offset_from_its_lane_m(
 
 #[test]
 fn the_simulators_drivers_follow_curved_lanes_and_successors() {
-    use mergesim::sim::Driver;
+    use mergesim::sim::config::Driver;
     // on_ramp: the ego keeps its lane from the ramp (a 150 m arc) into the acceleration lane,
     // its successor (no lane change); the others follow their main lanes with the IDM.
     let mut on_ramp = Scenario::load("on_ramp").unwrap();

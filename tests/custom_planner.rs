@@ -6,8 +6,10 @@ use std::sync::Arc;
 use mergesim::experiment::{InstanceOptions, RunError, run_instance};
 use mergesim::mergesim_types::{Behaviour, BehaviourError, Decision, Lane, Observation, PathPoint};
 use mergesim::scenarios::Scenario;
+use mergesim::sim::SimError;
+use mergesim::sim::config::Driver;
 use mergesim::sim::recording::Recorder;
-use mergesim::sim::{BehaviourRegistry, Driver, FactoryInput, SimError};
+use mergesim::sim::registry::{BehaviourRegistry, FactoryInput};
 
 /// Holds its spawn lane at a fixed speed of its own (ignoring the scenario's target).
 struct FixedSpeed {

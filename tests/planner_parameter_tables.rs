@@ -13,7 +13,8 @@ use mergesim::experiment::{InstanceOptions, RunError, run_instance};
 use mergesim::mergesim_types::{Behaviour, BehaviourError, Decision, Observation, PathPoint};
 use mergesim::scenarios::Scenario;
 use mergesim::sim::recording::Recorder;
-use mergesim::sim::{BehaviourRegistry, FactoryInput, ParamsError, PlannerParameters, SimError};
+use mergesim::sim::registry::{BehaviourRegistry, FactoryInput};
+use mergesim::sim::{ParamsError, PlannerParameters, SimError};
 
 const URGENT: &str = include_str!("../scenarios/builtin/urgent_merge.toml");
 const EGO_DRIVER: &str = "driver = { planner = \"pf-iso\" }";

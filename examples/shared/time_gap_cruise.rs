@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use mergesim::mergesim_types::{Behaviour, BehaviourError, Decision, Observation, PathPoint};
-use mergesim::sim::{BehaviourFactory, FactoryInput};
+use mergesim::sim::registry::{BehaviourFactory, FactoryInput};
 
 /// Constant-time-gap cruise control along the through lane.
 pub struct TimeGapCruise {

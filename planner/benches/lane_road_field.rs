@@ -10,9 +10,9 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use mergesim_types::lanes::{LaneRoad, THROUGH_LANE_ID, curved_merge_spec};
 use mergesim_types::{MergeRoad, VehicleShape};
-use planner::PlannerParams;
 use planner::attractive_field::AttractiveField;
 use planner::lane_road_field::{LaneRoadField, LaneRoadGeometry};
+use planner::params::PlannerParams;
 use planner::road_field::{RoadField, RoadFieldParams};
 
 /// 64 points over the first 400 m, across both lanes (the taper included).

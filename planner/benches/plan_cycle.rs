@@ -5,7 +5,9 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mergesim_types::{MergeRoad, Neighbour, SharedLocalPath, VehicleShape, VehicleState};
-use planner::{PfPlanner, PlanRequest, PlannerKind, PlannerParams, SpeedProgram};
+use planner::params::PlannerParams;
+use planner::speed_optimisation::SpeedProgram;
+use planner::{PfPlanner, PlanRequest, PlannerKind};
 
 type SharedLocalPathVec = Vec<SharedLocalPath>;
 

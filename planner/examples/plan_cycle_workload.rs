@@ -11,7 +11,8 @@
 use std::time::Instant;
 
 use mergesim_types::{MergeRoad, Neighbour, VehicleShape, VehicleState};
-use planner::{PfPlanner, PlanRequest, PlannerKind, PlannerParams};
+use planner::params::PlannerParams;
+use planner::{PfPlanner, PlanRequest, PlannerKind};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let rounds: usize = match std::env::args().nth(1) {

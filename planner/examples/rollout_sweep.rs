@@ -13,7 +13,8 @@
 //! `cargo run --release -p planner --example rollout_sweep`
 
 use mergesim_types::{Lane, MergeRoad, Neighbour, SharedLocalPath, VehicleShape, VehicleState};
-use planner::{PfPlanner, PlanRequest, PlannerKind, PlannerParams};
+use planner::params::PlannerParams;
+use planner::{PfPlanner, PlanRequest, PlannerKind};
 
 /// Replanning period and roll-out length (s).
 const STEP_S: f64 = 0.1;

@@ -55,7 +55,8 @@ impl Behaviour for PfPlanner {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{PlannerKind, PlannerParams};
+    use crate::PlannerKind;
+    use crate::params::PlannerParams;
     use mergesim_types::{MergeRoad, VehicleShape, VehicleState};
 
     #[test]

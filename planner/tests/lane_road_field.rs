@@ -7,10 +7,10 @@ use mergesim_types::lanes::{
     on_ramp_ids, on_ramp_spec,
 };
 use mergesim_types::{MergeRoad, VehicleShape};
-use planner::PlannerParams;
 use planner::attractive_field::{AttractionParams, AttractiveField};
 use planner::lane_frame::lane_relative_heading_rad;
 use planner::lane_road_field::{LaneAttraction, LaneRoadField, LaneRoadGeometry};
+use planner::params::PlannerParams;
 use planner::road_field::{RoadField, RoadFieldParams};
 
 fn half_width_m() -> f64 {

@@ -8,8 +8,10 @@ use std::sync::{Arc, Mutex};
 use mergesim_types::VehicleId;
 use pyo3::prelude::*;
 use scenarios::Scenario;
+use sim::config::Driver;
 use sim::recording::Recorder;
-use sim::{BehaviourRegistry, Driver, RunOptions, SimError, TickObserver, World};
+use sim::registry::BehaviourRegistry;
+use sim::{RunOptions, SimError, TickObserver, World};
 
 use crate::errors::BindingError;
 use crate::external::{Command, EXTERNAL_PLANNER, External, SharedCommand};
@@ -160,7 +162,7 @@ impl EnvCore {
         registry
             .register(
                 EXTERNAL_PLANNER,
-                Arc::new(move |_: &sim::FactoryInput<'_>| {
+                Arc::new(move |_: &sim::registry::FactoryInput<'_>| {
                     Ok(Box::new(External {
                         command: shared.clone(),
                     }) as Box<dyn mergesim_types::Behaviour>)

@@ -1,7 +1,7 @@
 //! Scenario definitions: the TOML format, validation, randomisation and the built-in scenarios.
 //!
-//! A scenario is a `[sim]` table (a [`sim::SimConfig`]), a list of `[[vehicles]]`
-//! ([`sim::VehicleSpec`]) and an optional `[randomise]` table ([`Randomisation`]) of the ranges
+//! A scenario is a `[sim]` table (a [`sim::config::SimConfig`]), a list of `[[vehicles]]`
+//! ([`sim::config::VehicleSpec`]) and an optional `[randomise]` table ([`Randomisation`]) of the ranges
 //! a Monte-Carlo sweep draws instances from. Unknown keys are rejected; every number is
 //! range-checked, for the nominal values and for every instance the ranges allow; errors name
 //! the file, the line and the field.

@@ -5,7 +5,7 @@ mod driver;
 use std::collections::BTreeMap;
 
 use mergesim_types::MergeRoad;
-use planner::PlannerParams;
+use planner::params::PlannerParams;
 use serde::{Deserialize, Serialize};
 use vehicles::TrackerParams;
 

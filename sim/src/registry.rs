@@ -77,8 +77,9 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
+use planner::params::PlannerParams;
 use planner::params_tables::{self, PF_TABLES};
-use planner::{PfPlanner, PlannerKind, PlannerParams};
+use planner::{PfPlanner, PlannerKind};
 
 use crate::config::{SimConfig, VehicleSpec};
 use crate::error::SimError;
@@ -98,7 +99,7 @@ pub struct FactoryInput<'a> {
     pub lanes: &'a Arc<mergesim_types::lanes::LaneRoad>,
     /// The vehicle's planner parameters, parsed and validated by the planner's schema (module
     /// doc): a `P` for a planner registered with `register_with_params::<P>`; for a built-in PF
-    /// planner a `planner::PlannerParams` when the vehicle has its own (`None`: the
+    /// planner a `planner::params::PlannerParams` when the vehicle has its own (`None`: the
     /// scenario's `config.planner`); `None` for a planner without parameters.
     pub params: Option<&'a (dyn std::any::Any + Send + Sync)>,
 }

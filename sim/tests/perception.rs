@@ -7,8 +7,10 @@ use std::sync::{Arc, Mutex};
 use mergesim_types::{
     Behaviour, BehaviourError, Decision, Lane, Observation, PathPoint, VehicleId,
 };
+use sim::config::{Driver, SimConfig, VehicleSpec};
 use sim::recording::Recorder;
-use sim::{BehaviourRegistry, Driver, FactoryInput, RunOptions, SimConfig, VehicleSpec, World};
+use sim::registry::{BehaviourRegistry, FactoryInput};
+use sim::{RunOptions, World};
 
 /// What one vehicle was given over the run: neighbour ids and shared-path sender ids.
 #[derive(Debug, Default)]

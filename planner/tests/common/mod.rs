@@ -3,7 +3,8 @@
 #![allow(dead_code)]
 
 use mergesim_types::{MergeRoad, Neighbour, SharedLocalPath, VehicleShape, VehicleState};
-use planner::{PfPlanner, PlanRequest, PlannerKind, PlannerParams};
+use planner::params::PlannerParams;
+use planner::{PfPlanner, PlanRequest, PlannerKind};
 
 /// A road whose merge section ends at x = 50 m: from there on one lane (the upper one), so a
 /// follower cannot overtake.
@@ -156,7 +157,7 @@ pub fn lateral_equilibrium_m(params: &PlannerParams, neighbour: Option<(f64, f64
         .into_iter()
         .collect();
     let geometry = planner::lane_road_field::LaneRoadGeometry::new(&road.lane_road().unwrap());
-    let field = planner::PotentialField::new(
+    let field = planner::potential_field::PotentialField::new(
         &planner::potential_field::UniversalFieldParams::from(params),
         &geometry,
         0,
