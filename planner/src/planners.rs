@@ -64,7 +64,7 @@ pub struct PfPlanner {
     params: PlannerParams,
     /// Each part's settings, derived from `params` once, at construction (`derived_params`).
     derived: DerivedParams,
-    /// The road as lanes, prepared once (`lane_road_field.rs`), shareable between planners.
+    /// The road as lanes, prepared once (`lane_road_field/geometry.rs`), shareable between planners.
     road: Arc<LaneRoadGeometry>,
     last_good: Option<Plan>,
     optimiser: SpeedOptimiser,
