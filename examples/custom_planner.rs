@@ -12,7 +12,7 @@
 //! `cargo run --release --example custom_planner`
 
 use mergesim::experiment::{InstanceOptions, run_instance};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::config::Driver;
 use mergesim::sim::recording::Recorder;
 use mergesim::sim::registry::BehaviourRegistry;

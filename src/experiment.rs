@@ -5,7 +5,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use sim::recording::Recorder;
 use sim::registry::BehaviourRegistry;
 use sim::{RunOptions, RunOutcome, SimError, World};

@@ -22,7 +22,7 @@ use std::time::Instant;
 use planner::PlannerKind;
 use planner::params::PlannerParams;
 use rayon::prelude::*;
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use serde::{Deserialize, Serialize};
 use sim::registry::BehaviourRegistry;
 

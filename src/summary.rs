@@ -110,7 +110,7 @@ impl RunSummary {
 
     /// The summary with `drawn` filled from `scenario` (the scenario the run's instance was
     /// drawn from; nothing for a run without a seed).
-    pub fn with_drawn(mut self, scenario: &scenarios::Scenario) -> Self {
+    pub fn with_drawn(mut self, scenario: &scenarios::scenario::Scenario) -> Self {
         self.drawn = self
             .seed
             .map(|seed| crate::sweep::drawn_values(scenario, seed));

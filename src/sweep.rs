@@ -37,7 +37,7 @@ use std::sync::atomic::AtomicBool;
 #[cfg(test)]
 use std::sync::atomic::Ordering;
 
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use sim::registry::BehaviourRegistry;
 use sim::rng::SplitMix64;
 

@@ -5,7 +5,7 @@
 mod common;
 
 use common::{merge_sim, scratch, stderr};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 
 /// urgent_merge with its road written out as lanes (scenarios/tests/lane_road.rs has the same
 /// text; the vehicles are urgent_merge's, at s = x + 50 m since the lanes start at x = −50 m).

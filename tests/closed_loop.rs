@@ -3,7 +3,7 @@
 mod common;
 
 use mergesim::planner::PlannerKind;
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::RunOutcome;
 
 fn run(scenario: &Scenario, planner: Option<PlannerKind>, keep_time_series: bool) -> RunOutcome {

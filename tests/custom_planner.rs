@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use mergesim::experiment::{InstanceOptions, RunError, run_instance};
 use mergesim::mergesim_types::{Behaviour, BehaviourError, Decision, Lane, Observation, PathPoint};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::SimError;
 use mergesim::sim::config::Driver;
 use mergesim::sim::recording::Recorder;

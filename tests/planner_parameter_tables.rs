@@ -11,7 +11,7 @@ use std::sync::{Arc, Mutex};
 use common::{merge_sim, scratch, stderr};
 use mergesim::experiment::{InstanceOptions, RunError, run_instance};
 use mergesim::mergesim_types::{Behaviour, BehaviourError, Decision, Observation, PathPoint};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::recording::Recorder;
 use mergesim::sim::registry::{BehaviourRegistry, FactoryInput};
 use mergesim::sim::{ParamsError, PlannerParameters, SimError};

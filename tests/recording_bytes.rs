@@ -10,7 +10,7 @@ use std::io::BufReader;
 use std::path::Path;
 
 use mergesim::experiment::{InstanceOptions, run_instance};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::recording::{Recorder, RecorderParams};
 use mergesim::sim::registry::BehaviourRegistry;
 use re_log_encoding::DecoderApp;

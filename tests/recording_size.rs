@@ -4,7 +4,7 @@
 mod common;
 
 use mergesim::experiment::{InstanceOptions, run_instance};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::recording::size_estimate::estimated_bytes;
 use mergesim::sim::recording::{Recorder, RecorderParams};
 use mergesim::sim::registry::BehaviourRegistry;

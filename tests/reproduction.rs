@@ -10,7 +10,7 @@
 mod common;
 
 use mergesim::planner::{ParameterSet, PlannerKind};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::RunOutcome;
 use mergesim::sim::metrics::VehicleMetricsSummary;
 use mergesim::sim::paper_metrics::PaperMetricsSummary;

@@ -4,7 +4,8 @@
 mod common;
 
 use mergesim::planner::PlannerKind;
-use mergesim::scenarios::{Scenario, builtin};
+use mergesim::scenarios::builtin;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::RunOutcome;
 
 fn run(scenario: &Scenario, planner: Option<PlannerKind>, seed: u64) -> RunOutcome {

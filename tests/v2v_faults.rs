@@ -5,7 +5,7 @@
 
 use mergesim::planner::PlannerKind;
 use mergesim::planner::following::V2vLossFallback;
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sweep::{Shard, SweepOptions, SweepPlan, SweepSummary, run_sweep};
 
 const SEED: u64 = 1;

@@ -127,8 +127,8 @@ pub fn path_curvature_on_lane_1pm(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mergesim_types::MergeRoad;
     use mergesim_types::lanes::{LaneRoad, THROUGH_LANE_ID, curved_merge_spec};
-    use mergesim_types::road::MergeRoad;
 
     fn arc_road() -> LaneRoad {
         LaneRoad::new(&curved_merge_spec(&MergeRoad::default(), 300.0).unwrap()).unwrap()

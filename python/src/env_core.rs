@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 
 use mergesim_types::VehicleId;
 use pyo3::prelude::*;
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use sim::config::Driver;
 use sim::recording::Recorder;
 use sim::registry::BehaviourRegistry;

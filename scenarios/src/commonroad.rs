@@ -429,7 +429,7 @@ impl Scenario {
                 ..defaults
             },
             vehicles: vec![ego],
-            randomise: crate::Randomisation::default(),
+            randomise: crate::randomisation::Randomisation::default(),
             planner_overrides: toml::Table::new(),
             source: None,
         };

@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
-use scenarios::{Scenario, ScenarioError};
+use scenarios::scenario::{Scenario, ScenarioError};
 use sim::registry::{BehaviourRegistry, FactoryInput};
 use sim::{ParamsError, PlannerParameters};
 

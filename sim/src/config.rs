@@ -7,10 +7,11 @@ use std::collections::BTreeMap;
 use mergesim_types::MergeRoad;
 use planner::params::PlannerParams;
 use serde::{Deserialize, Serialize};
-use vehicles::TrackerParams;
+use vehicles::tracker::TrackerParams;
 
+use mergesim_types::bounds;
+use mergesim_types::bounds::Bound;
 use mergesim_types::lanes::LaneId;
-use mergesim_types::{Bound, bounds};
 
 pub use driver::Driver;
 

@@ -16,7 +16,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use mergesim_types::{Bound, bounds};
+use mergesim_types::bounds;
+use mergesim_types::bounds::Bound;
 
 use crate::error::SimError;
 

@@ -19,7 +19,8 @@ use std::collections::BTreeMap;
 use mergesim_types::{SharedLocalPath, VehicleId};
 use serde::{Deserialize, Serialize};
 
-use mergesim_types::{Bound, bounds};
+use mergesim_types::bounds;
+use mergesim_types::bounds::Bound;
 
 use crate::error::SimError;
 use crate::rng::SplitMix64;

@@ -12,7 +12,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow};
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 
 use crate::animation::{GifParams, GifView};
 use crate::cli::args::RunArgs;

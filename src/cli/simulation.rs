@@ -4,7 +4,7 @@
 
 use anyhow::Context;
 use planner::ParameterSet;
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use sim::recording::{Recorder, RecorderParams};
 
 use crate::cli::{Failure, Session, args, input, interrupted, run_failure};

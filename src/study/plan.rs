@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use scenarios::source_location::line_of;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;

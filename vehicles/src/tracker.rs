@@ -15,7 +15,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::controls::Controls;
-use mergesim_types::{Bound, bounds};
+use mergesim_types::bounds;
+use mergesim_types::bounds::Bound;
 
 use crate::error::VehicleError;
 use crate::kinematics::Kinematics;
