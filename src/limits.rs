@@ -159,7 +159,7 @@ pub fn other_limits() -> Vec<(String, String)> {
             format!(
                 "{} to {} runs",
                 2 * crate::study::plan::MIN_INSTANCES,
-                crate::study::MAX_STUDY_RUNS
+                crate::study::plan::MAX_STUDY_RUNS
             ),
         ),
         (
