@@ -9,8 +9,7 @@ use planner::params::PlannerParams;
 use serde::{Deserialize, Serialize};
 use vehicles::tracker::TrackerParams;
 
-use mergesim_types::bounds;
-use mergesim_types::bounds::Bound;
+use mergesim_types::bounds::{self, Bound};
 use mergesim_types::lanes::LaneId;
 
 pub use driver::Driver;

@@ -16,8 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use mergesim_types::bounds;
-use mergesim_types::bounds::Bound;
+use mergesim_types::bounds::{self, Bound};
 
 use crate::error::SimError;
 

@@ -19,8 +19,7 @@ use std::collections::BTreeMap;
 use mergesim_types::{SharedLocalPath, VehicleId};
 use serde::{Deserialize, Serialize};
 
-use mergesim_types::bounds;
-use mergesim_types::bounds::Bound;
+use mergesim_types::bounds::{self, Bound};
 
 use crate::error::SimError;
 use crate::rng::SplitMix64;

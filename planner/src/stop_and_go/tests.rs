@@ -6,8 +6,9 @@ use crate::parameter_set::ParameterSet;
 use crate::params::PlannerParams;
 use crate::planner_kind::PlannerKind;
 use crate::planners::PfPlanner;
-use mergesim_types::{Lane, MergeRoad};
-use mergesim_types::{Neighbour, SharedLocalPath, TimedWaypoint, VehicleShape, VehicleState};
+use mergesim_types::{
+    Lane, MergeRoad, Neighbour, SharedLocalPath, TimedWaypoint, VehicleShape, VehicleState,
+};
 
 /// The merge road with its merge section ending at x = 50 m: one lane (the upper) beyond, so
 /// nobody can pass the stopped car.
