@@ -4,7 +4,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mergesim::experiment::{InstanceOptions, run_quietly};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 
 fn urgent_merge(c: &mut Criterion) {
     let scenario = match Scenario::load("urgent_merge") {

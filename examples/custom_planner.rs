@@ -12,9 +12,10 @@
 //! `cargo run --release --example custom_planner`
 
 use mergesim::experiment::{InstanceOptions, run_instance};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
+use mergesim::sim::config::Driver;
 use mergesim::sim::recording::Recorder;
-use mergesim::sim::{BehaviourRegistry, Driver};
+use mergesim::sim::registry::BehaviourRegistry;
 
 #[path = "shared/time_gap_cruise.rs"]
 mod time_gap_cruise;

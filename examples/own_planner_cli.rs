@@ -11,7 +11,7 @@
 
 use std::process::ExitCode;
 
-use mergesim::sim::BehaviourRegistry;
+use mergesim::sim::registry::BehaviourRegistry;
 
 #[path = "shared/time_gap_cruise.rs"]
 mod time_gap_cruise;

@@ -13,8 +13,8 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::Parser;
 use mergesim::scaling::{ScalingPoint, markdown_table, measure, write_png};
-use mergesim::scenarios::Scenario;
 use mergesim::scenarios::platoon::platoon;
+use mergesim::scenarios::scenario::Scenario;
 
 #[derive(Parser, Debug)]
 #[command(about = "Cost per simulated vehicle-second as the platoon grows")]

@@ -401,7 +401,7 @@ mod tests {
     }
 
     fn merge_lanes() -> LaneRoad {
-        sim::MergeRoad::default()
+        mergesim_types::MergeRoad::default()
             .lane_road()
             .unwrap_or_else(|e| panic!("{e}"))
     }
@@ -487,7 +487,7 @@ mod tests {
     #[test]
     fn the_road_view_shows_every_vehicle_at_its_place() {
         ensure_font().unwrap_or_else(|e| panic!("{e}"));
-        let road = sim::MergeRoad::default();
+        let road = mergesim_types::MergeRoad::default();
         // The same two vehicles, 300 m apart: the follow view loses one, the road view has both.
         let instant = [row("ego", 0.0, 1.75), row("far", 300.0, 5.25)];
         let geometry = FrameGeometry::whole_road(&merge_lanes(), &GifParams::default(), &instant);

@@ -5,9 +5,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use sim::recording::Recorder;
-use sim::{BehaviourRegistry, RunOptions, RunOutcome, SimError, World};
+use sim::registry::BehaviourRegistry;
+use sim::{RunOptions, RunOutcome, SimError, World};
 use thiserror::Error;
 
 use crate::summary::RunSummary;
@@ -68,7 +69,7 @@ pub fn planner_label(scenario: &Scenario, planner: Option<&str>) -> String {
         .vehicles
         .iter()
         .filter_map(|v| match &v.driver {
-            sim::Driver::Planner { name, .. } => Some(name.as_str()),
+            sim::config::Driver::Planner { name, .. } => Some(name.as_str()),
             _ => None,
         })
         .collect();

@@ -19,11 +19,12 @@
 
 use std::time::Instant;
 
-use planner::{PlannerKind, PlannerParams};
+use planner::PlannerKind;
+use planner::params::PlannerParams;
 use rayon::prelude::*;
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use serde::{Deserialize, Serialize};
-use sim::BehaviourRegistry;
+use sim::registry::BehaviourRegistry;
 
 use crate::experiment::{InstanceOptions, run_instance};
 

@@ -4,7 +4,8 @@
 //! calls [`cli::main_with`]). The workspace's crates, re-exported for the `merge_sim` binary, the integration tests and
 //! the benchmarks: [`planner`] (pure potential-field planning with interactive speed
 //! optimisation), [`vehicles`] (Rapier vehicles and tracker), [`sim`] (the closed loop) and
-//! [`scenarios`] (scenario files).
+//! [`scenarios`] (scenario files), and the plain data they all speak, [`mergesim_types`] (vehicle
+//! state and shape, paths, roads, the `Behaviour` interface): `mergesim::mergesim_types::X`.
 //!
 //! # Public API
 //! - The command line: [`cli::main`] and [`cli::main_with`] (a registry with the user's own
@@ -38,4 +39,4 @@ pub mod study;
 pub mod summary;
 pub mod sweep;
 
-pub use {planner, scenarios, sim, vehicles};
+pub use {mergesim_types, planner, scenarios, sim, vehicles};

@@ -7,7 +7,7 @@
 
 use mergesim_types::bounds::{Bound, markdown_rows};
 use mergesim_types::lanes::{CURVED_MERGE_RADIUS_M, ON_RAMP_BOUNDS};
-use mergesim_types::road::{MERGE_SECTION_LENGTH_M, ROAD_BOUNDS};
+use mergesim_types::{MERGE_SECTION_LENGTH_M, ROAD_BOUNDS};
 use planner::params::{MAX_WAYPOINTS, MIN_WAYPOINTS, PLANNER_BOUNDS};
 use scenarios::scenario::ROAD_END_SPEED_ALLOWANCE;
 use sim::config::{
@@ -159,7 +159,7 @@ pub fn other_limits() -> Vec<(String, String)> {
             format!(
                 "{} to {} runs",
                 2 * crate::study::plan::MIN_INSTANCES,
-                crate::study::MAX_STUDY_RUNS
+                crate::study::plan::MAX_STUDY_RUNS
             ),
         ),
         (

@@ -26,7 +26,7 @@ pub struct RunCaption {
 
 impl RunCaption {
     /// The caption of `scenario`'s instance `seed` (None: nominal), with this build's commit.
-    pub fn of_scenario(scenario: &scenarios::Scenario, seed: Option<u64>) -> Self {
+    pub fn of_scenario(scenario: &scenarios::scenario::Scenario, seed: Option<u64>) -> Self {
         let keys: Vec<&str> = scenario
             .planner_overrides
             .keys()
@@ -115,7 +115,8 @@ mod tests {
 
     #[test]
     fn a_builtin_is_its_set_and_overrides_make_it_custom() {
-        let scenario = scenarios::Scenario::load("urgent_merge").unwrap_or_else(|e| panic!("{e}"));
+        let scenario =
+            scenarios::scenario::Scenario::load("urgent_merge").unwrap_or_else(|e| panic!("{e}"));
         let caption = RunCaption::of_scenario(&scenario, None);
         assert_eq!(caption.params, scenario.params.name());
         assert_eq!(caption.commit, crate::build_info::short_commit());

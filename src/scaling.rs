@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use plotters::prelude::*;
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 
 use crate::experiment::{Finished, InstanceOptions, RunError, run_quietly};
 use crate::plots::{PlotError, ensure_font, font, render_png};

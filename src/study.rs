@@ -3,9 +3,9 @@
 //! thresholds, collision handling), run paired on the same instances, resumable and shardable
 //! like a sweep, and reported with the statistics a referee expects.
 //!
-//! - [`plan`]: the plan format (`PLAN_FORMAT`), checked before any run;
+//! - [`plan`]: the plan format (`PLAN_FORMAT`), checked before any run ([`plan::StudyPlan`]);
 //! - `endpoints`: the figures a plan may name and their units;
-//! - [`runner`]: the runs and their rows (JSONL), shards and resumption;
+//! - [`runner`]: the runs and their rows (JSONL), shards and resumption ([`runner::run_study`]);
 //! - `analysis`: paired differences, t-interval, t-test, Wilcoxon, Holm, McNemar, Newcombe
 //!   (computed by [`crate::inference`]);
 //! - `report`, `figure`, [`provenance`]: the report folder and what it cites.
@@ -21,9 +21,9 @@ pub mod runner;
 use std::path::Path;
 
 pub use analysis::{Analysis, analyse};
-pub use plan::{MAX_STUDY_RUNS, PlanError, StudyPlan};
+use plan::StudyPlan;
 pub(crate) use report::StudyReport;
-pub use runner::{RunOptions, StudyError, StudyRow, run_study};
+use runner::{RunOptions, StudyError, run_study};
 
 /// The plan format, as `merge_sim study --help` prints it.
 pub(crate) const PLAN_FORMAT: &str = include_str!("study/plan_format.txt");

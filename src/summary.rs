@@ -110,7 +110,7 @@ impl RunSummary {
 
     /// The summary with `drawn` filled from `scenario` (the scenario the run's instance was
     /// drawn from; nothing for a run without a seed).
-    pub fn with_drawn(mut self, scenario: &scenarios::Scenario) -> Self {
+    pub fn with_drawn(mut self, scenario: &scenarios::scenario::Scenario) -> Self {
         self.drawn = self
             .seed
             .map(|seed| crate::sweep::drawn_values(scenario, seed));
@@ -119,7 +119,7 @@ impl RunSummary {
 
     /// The summary with `recorded_traffic` named from `sim`: the mode of its CommonRoad road's
     /// recorded traffic, nothing on any other road.
-    pub fn with_recorded_traffic(mut self, sim: &sim::SimConfig) -> Self {
+    pub fn with_recorded_traffic(mut self, sim: &sim::config::SimConfig) -> Self {
         self.recorded_traffic = sim
             .commonroad_road()
             .map(|road| road.recorded_traffic.to_string());
@@ -216,9 +216,11 @@ impl RunSummary {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mergesim_types::Lane;
+    use sim::config::{Driver, SimConfig, VehicleSpec};
     use sim::recorded_traffic::{RecordedState, RecordedTraffic, RecordedVehicle, TrafficMode};
     use sim::recording::Recorder;
-    use sim::{Driver, Lane, RunOptions, SimConfig, VehicleSpec, World};
+    use sim::{RunOptions, World};
 
     /// A recorded car running into a lane-keeping car from behind (as in
     /// `sim/tests/recorded_traffic.rs`): the summary counts it apart.

@@ -37,8 +37,8 @@ use std::sync::atomic::AtomicBool;
 #[cfg(test)]
 use std::sync::atomic::Ordering;
 
-use scenarios::Scenario;
-use sim::BehaviourRegistry;
+use scenarios::scenario::Scenario;
+use sim::registry::BehaviourRegistry;
 use sim::rng::SplitMix64;
 
 use thiserror::Error;

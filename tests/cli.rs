@@ -236,8 +236,8 @@ fn scenario_show_reads_back_unchanged() {
     assert!(out.status.success());
     let path = dir.join("urgent.toml");
     std::fs::write(&path, &out.stdout).unwrap();
-    let a = scenarios::Scenario::load("urgent_merge").unwrap();
-    let b = scenarios::Scenario::load(path.to_str().unwrap()).unwrap();
+    let a = scenarios::scenario::Scenario::load("urgent_merge").unwrap();
+    let b = scenarios::scenario::Scenario::load(path.to_str().unwrap()).unwrap();
     assert_eq!(a, b);
     let list = merge_sim(&["scenario", "list"]);
     assert!(String::from_utf8_lossy(&list.stdout).contains("urgent_merge"));

@@ -5,7 +5,7 @@
 mod common;
 
 use common::{merge_sim, scratch, stderr};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 
 /// urgent_merge with its road written out as lanes (scenarios/tests/lane_road.rs has the same
 /// text; the vehicles are urgent_merge's, at s = x + 50 m since the lanes start at x = −50 m).
@@ -172,7 +172,7 @@ fn max_offset_from_its_lane_m(
 
 #[test]
 fn the_simulators_drivers_follow_curved_lanes_and_successors() {
-    use mergesim::sim::Driver;
+    use mergesim::sim::config::Driver;
     // on_ramp: the ego keeps its lane from the ramp (a 150 m arc) into the acceleration lane,
     // its successor (no lane change); the others follow their main lanes with the IDM.
     let mut on_ramp = Scenario::load("on_ramp").unwrap();

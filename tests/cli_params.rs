@@ -83,7 +83,7 @@ fn a_scenario_s_planner_values_apply_on_top_of_its_set() {
         .replacen("[sim]", "params = \"paper\"\n\n[sim]", 1)
         + "\n[sim.planner]\nobstacle_time_gap_s = 1.5\n";
     std::fs::write(&file, &text).unwrap();
-    let scenario = mergesim::scenarios::Scenario::load(file.to_str().unwrap()).unwrap();
+    let scenario = mergesim::scenarios::scenario::Scenario::load(file.to_str().unwrap()).unwrap();
     assert_eq!(scenario.params, mergesim::planner::ParameterSet::Paper);
     assert_eq!(scenario.sim.planner.obstacle_time_gap_s, 1.5);
     // Everything else is the paper set's.
@@ -96,7 +96,8 @@ fn a_scenario_s_planner_values_apply_on_top_of_its_set() {
     assert!(ours.sim.planner.predict_obstacles_in_path);
     // And the text written back reads back the same.
     let again =
-        mergesim::scenarios::Scenario::from_toml(&scenario.to_toml().unwrap(), "x").unwrap();
+        mergesim::scenarios::scenario::Scenario::from_toml(&scenario.to_toml().unwrap(), "x")
+            .unwrap();
     assert_eq!(again.sim.planner, scenario.sim.planner);
 }
 

@@ -3,7 +3,7 @@
 mod common;
 
 use mergesim::planner::PlannerKind;
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::RunOutcome;
 
 fn run(scenario: &Scenario, planner: Option<PlannerKind>, keep_time_series: bool) -> RunOutcome {
@@ -202,7 +202,7 @@ fn planner_stats_count_the_optimisers_solves_and_capped_cycles() {
     assert!(iso.optimiser_iteration_cap_cycles <= iso.plans);
     let with_iterations = |iterations: usize| {
         let mut s = scenario.clone();
-        s.sim.planner.speed_program = mergesim::planner::SpeedProgram::NewtonQp;
+        s.sim.planner.speed_program = mergesim::planner::speed_optimisation::SpeedProgram::NewtonQp;
         s.sim.planner.max_scp_iterations = iterations;
         run(&s, Some(PlannerKind::PfIso), false).planner_stats
     };

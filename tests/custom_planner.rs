@@ -4,12 +4,12 @@
 use std::sync::Arc;
 
 use mergesim::experiment::{InstanceOptions, RunError, run_instance};
-use mergesim::scenarios::Scenario;
+use mergesim::mergesim_types::{Behaviour, BehaviourError, Decision, Lane, Observation, PathPoint};
+use mergesim::scenarios::scenario::Scenario;
+use mergesim::sim::SimError;
+use mergesim::sim::config::Driver;
 use mergesim::sim::recording::Recorder;
-use mergesim::sim::{
-    Behaviour, BehaviourError, BehaviourRegistry, Decision, Driver, FactoryInput, Lane,
-    Observation, PathPoint, SimError,
-};
+use mergesim::sim::registry::{BehaviourRegistry, FactoryInput};
 
 /// Holds its spawn lane at a fixed speed of its own (ignoring the scenario's target).
 struct FixedSpeed {
@@ -21,8 +21,8 @@ impl Behaviour for FixedSpeed {
     fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError> {
         // Its spawn lane as a lane of the road (the merge road's lanes by their ids).
         let id = match self.lane {
-            Lane::Upper => mergesim::sim::lanes::THROUGH_LANE_ID,
-            Lane::Lower => mergesim::sim::lanes::ENDING_LANE_ID,
+            Lane::Upper => mergesim::mergesim_types::lanes::THROUGH_LANE_ID,
+            Lane::Lower => mergesim::mergesim_types::lanes::ENDING_LANE_ID,
         };
         let lane = obs.lanes.lane(id).ok_or("no such lane")?;
         let s_m = lane.project([obs.ego.x_m, obs.ego.y_m]).s_m;

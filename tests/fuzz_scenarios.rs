@@ -12,7 +12,8 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 use mergesim::experiment::{InstanceOptions, run_quietly};
-use mergesim::scenarios::{Scenario, builtin};
+use mergesim::scenarios::builtin;
+use mergesim::scenarios::scenario::Scenario;
 use proptest::prelude::*;
 
 /// Numbers a damaged field may take.

@@ -321,7 +321,7 @@ primary = {{ figure = "obstacle.max_abs_yaw_rate_radps", threshold = "0.01 rad/s
 
 #[test]
 fn the_stock_binary_refuses_the_name_and_the_help_lists_it() {
-    let builtins = mergesim::sim::BehaviourRegistry::builtin()
+    let builtins = mergesim::sim::registry::BehaviourRegistry::builtin()
         .names()
         .join(", ");
     for args in [

@@ -10,12 +10,11 @@ use std::sync::{Arc, Mutex};
 
 use common::{merge_sim, scratch, stderr};
 use mergesim::experiment::{InstanceOptions, RunError, run_instance};
-use mergesim::scenarios::Scenario;
+use mergesim::mergesim_types::{Behaviour, BehaviourError, Decision, Observation, PathPoint};
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::recording::Recorder;
-use mergesim::sim::{
-    Behaviour, BehaviourError, BehaviourRegistry, Decision, FactoryInput, Observation, ParamsError,
-    PathPoint, PlannerParameters, SimError,
-};
+use mergesim::sim::registry::{BehaviourRegistry, FactoryInput};
+use mergesim::sim::{ParamsError, PlannerParameters, SimError};
 
 const URGENT: &str = include_str!("../scenarios/builtin/urgent_merge.toml");
 const EGO_DRIVER: &str = "driver = { planner = \"pf-iso\" }";

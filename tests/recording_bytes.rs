@@ -10,9 +10,9 @@ use std::io::BufReader;
 use std::path::Path;
 
 use mergesim::experiment::{InstanceOptions, run_instance};
-use mergesim::scenarios::Scenario;
-use mergesim::sim::BehaviourRegistry;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::recording::{Recorder, RecorderParams};
+use mergesim::sim::registry::BehaviourRegistry;
 use re_log_encoding::DecoderApp;
 use rerun::StoreKind;
 use rerun::log::{Chunk, LogMsg};

@@ -4,10 +4,10 @@
 mod common;
 
 use mergesim::experiment::{InstanceOptions, run_instance};
-use mergesim::scenarios::Scenario;
-use mergesim::sim::BehaviourRegistry;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::recording::size_estimate::estimated_bytes;
 use mergesim::sim::recording::{Recorder, RecorderParams};
+use mergesim::sim::registry::BehaviourRegistry;
 
 /// Records `scenario` with `detail` vehicles in detail; returns (bytes written, estimate).
 fn record(scenario: &Scenario, detail: Option<usize>, name: &str) -> (f64, f64) {

@@ -10,7 +10,7 @@
 mod common;
 
 use mergesim::planner::{ParameterSet, PlannerKind};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::RunOutcome;
 use mergesim::sim::metrics::VehicleMetricsSummary;
 use mergesim::sim::paper_metrics::PaperMetricsSummary;
@@ -71,7 +71,10 @@ const PERTURBATIONS: [Perturbation; 9] = [
     Perturbation::Mu(0.9),
 ];
 
-fn vehicle_mut<'a>(scenario: &'a mut Scenario, name: &str) -> &'a mut mergesim::sim::VehicleSpec {
+fn vehicle_mut<'a>(
+    scenario: &'a mut Scenario,
+    name: &str,
+) -> &'a mut mergesim::sim::config::VehicleSpec {
     scenario
         .vehicles
         .iter_mut()
@@ -400,7 +403,7 @@ fn interaction_parameters_do_not_move_the_baselines() {
     p.interaction_weight = 30.0;
     p.interaction_rear_only = false;
     p.interaction_slows_only = true;
-    p.interaction_slp_reading = mergesim::planner::SlpReading::FixedWaypoints;
+    p.interaction_slp_reading = mergesim::planner::params::SlpReading::FixedWaypoints;
     for kind in [PlannerKind::PfCs, PlannerKind::PfSp, PlannerKind::PfSpEq10] {
         let a = common::simulate(&base, Some(kind), 0, true);
         let b = common::simulate(&changed, Some(kind), 0, true);

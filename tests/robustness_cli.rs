@@ -490,7 +490,7 @@ fn every_experiment_scenario_loads() {
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "toml") {
-            mergesim::scenarios::Scenario::load(path.to_str().unwrap())
+            mergesim::scenarios::scenario::Scenario::load(path.to_str().unwrap())
                 .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
             count += 1;
         }

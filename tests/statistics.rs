@@ -6,7 +6,7 @@
 //! Both planners run the same instances (same sweep seed), so the comparisons are paired.
 
 use mergesim::planner::PlannerKind;
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::summary::RunSummary;
 use mergesim::sweep::{
     RunMetrics, Shard, SweepOptions, SweepPlan, SweepSummary, instance_seed, run_sweep,

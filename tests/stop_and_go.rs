@@ -7,7 +7,7 @@
 mod common;
 
 use mergesim::planner::PlannerKind;
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::{RunOutcome, TimeSeriesRow};
 
 /// Time the car ahead starts (s).

@@ -5,8 +5,9 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use mergesim::inference;
+use mergesim::study::analyse;
+use mergesim::study::plan::StudyPlan;
 use mergesim::study::runner::{EndpointValues, StudyRow};
-use mergesim::study::{StudyPlan, analyse};
 use mergesim::sweep::{RunStatus, instance_seed};
 
 const PLAN: &str = r#"name = "synthetic"

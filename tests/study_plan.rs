@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use mergesim::study::StudyPlan;
 use mergesim::study::plan::EndpointWindow;
+use mergesim::study::plan::StudyPlan;
 
 const HEAD: &str = r#"name = "p"
 scenario = "urgent_merge"

@@ -3,7 +3,7 @@
 //! figures of the same run stopped at the last logged instant before the contact.
 
 use mergesim::experiment::{InstanceOptions, run_quietly};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 
 fn rear_end() -> Scenario {
     Scenario::load(concat!(

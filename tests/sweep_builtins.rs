@@ -4,7 +4,8 @@
 mod common;
 
 use mergesim::planner::PlannerKind;
-use mergesim::scenarios::{Scenario, builtin};
+use mergesim::scenarios::builtin;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::RunOutcome;
 
 fn run(scenario: &Scenario, planner: Option<PlannerKind>, seed: u64) -> RunOutcome {
@@ -121,7 +122,7 @@ fn builtins_have_the_documented_settings_and_ranges() {
         u.randomise.corner(&u.sim, &u.vehicles, true),
     );
     assert!((lo.0.mu - 0.7).abs() < 1e-12 && (hi.0.mu - 0.9).abs() < 1e-12);
-    let gap = |v: &[mergesim::sim::VehicleSpec]| v[1].x_m - v[0].x_m;
+    let gap = |v: &[mergesim::sim::config::VehicleSpec]| v[1].x_m - v[0].x_m;
     assert!((gap(&hi.1) - gap(&u.vehicles) - 3.0).abs() < 1e-12);
     assert!((gap(&lo.1) - gap(&u.vehicles) + 3.0).abs() < 1e-12);
     for (l, h, n) in

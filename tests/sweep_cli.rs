@@ -326,8 +326,8 @@ fn every_builtin_is_listed_and_shows_as_toml_that_reads_back_unchanged() {
         assert!(out.status.success(), "{}", stderr(&out));
         let path = dir.join(format!("{name}.toml"));
         std::fs::write(&path, &out.stdout).unwrap();
-        let a = mergesim::scenarios::Scenario::load(name).unwrap();
-        let b = mergesim::scenarios::Scenario::load(p(&path)).unwrap();
+        let a = mergesim::scenarios::scenario::Scenario::load(name).unwrap();
+        let b = mergesim::scenarios::scenario::Scenario::load(p(&path)).unwrap();
         assert_eq!(a, b, "{name}");
         assert!(
             !b.randomise.is_empty(),

@@ -14,7 +14,7 @@
 mod common;
 
 use mergesim::planner::{ParameterSet, PlannerKind};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::TimeSeriesRow;
 
 /// Largest excess of the tracked speed over the planned speed (m/s), from the issue.

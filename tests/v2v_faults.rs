@@ -3,8 +3,9 @@
 //! platoon no worse than with V2V), and latency, jitter (reordering), duplicates and losses
 //! together.
 
-use mergesim::planner::{PlannerKind, V2vLossFallback};
-use mergesim::scenarios::Scenario;
+use mergesim::planner::PlannerKind;
+use mergesim::planner::following::V2vLossFallback;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sweep::{Shard, SweepOptions, SweepPlan, SweepSummary, run_sweep};
 
 const SEED: u64 = 1;

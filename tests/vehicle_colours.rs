@@ -10,7 +10,7 @@ use std::path::Path;
 
 use common::{merge_sim, scratch, stderr};
 use mergesim::animation::{FrameGeometry, GifParams, GifView};
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use re_log_encoding::DecoderApp;
 use rerun::log::{Chunk, LogMsg};
 

@@ -5,9 +5,8 @@
 
 use std::sync::Arc;
 
-use mergesim::sim::{
-    Behaviour, BehaviourError, BehaviourFactory, Decision, FactoryInput, Observation, PathPoint,
-};
+use mergesim::mergesim_types::{Behaviour, BehaviourError, Decision, Observation, PathPoint};
+use mergesim::sim::registry::{BehaviourFactory, FactoryInput};
 
 /// Constant-time-gap cruise control along the through lane.
 pub struct TimeGapCruise {

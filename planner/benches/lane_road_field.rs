@@ -9,10 +9,11 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mergesim_types::lanes::{LaneRoad, THROUGH_LANE_ID, curved_merge_spec};
+use mergesim_types::{MergeRoad, VehicleShape};
 use planner::attractive_field::AttractiveField;
 use planner::lane_road_field::{LaneRoadField, LaneRoadGeometry};
+use planner::params::PlannerParams;
 use planner::road_field::{RoadField, RoadFieldParams};
-use planner::{MergeRoad, PlannerParams, VehicleShape};
 
 /// 64 points over the first 400 m, across both lanes (the taper included).
 fn points(map: impl Fn(f64, f64) -> [f64; 2]) -> Vec<[f64; 2]> {
@@ -83,8 +84,12 @@ fn bench(c: &mut Criterion) {
     let curved_field =
         LaneRoadField::new(&curved_geometry, &RoadFieldParams::from(&p), half_width_m);
     let curved_lane = curved.lane(THROUGH_LANE_ID).expect("lane");
-    let curved_pts =
-        points(|x, y| curved_lane.point(x + 50.0, y - road.lane_center_y_m(planner::Lane::Upper)));
+    let curved_pts = points(|x, y| {
+        curved_lane.point(
+            x + 50.0,
+            y - road.lane_center_y_m(mergesim_types::Lane::Upper),
+        )
+    });
     let curved_target = curved_lane.centreline();
     c.bench_function("road_terms_lane_frame_curved_64_points", |b| {
         b.iter(|| {

@@ -4,10 +4,10 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use planner::{
-    MergeRoad, Neighbour, PfPlanner, PlanRequest, PlannerKind, PlannerParams, SharedLocalPath,
-    SpeedProgram, VehicleShape, VehicleState,
-};
+use mergesim_types::{MergeRoad, Neighbour, SharedLocalPath, VehicleShape, VehicleState};
+use planner::params::PlannerParams;
+use planner::speed_optimisation::SpeedProgram;
+use planner::{PfPlanner, PlanRequest, PlannerKind};
 
 type SharedLocalPathVec = Vec<SharedLocalPath>;
 

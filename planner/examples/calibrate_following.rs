@@ -7,7 +7,8 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use planner::{PlannerKind, PlannerParams};
+use planner::PlannerKind;
+use planner::params::PlannerParams;
 
 fn scan_floor() {
     let base = PlannerParams::default();

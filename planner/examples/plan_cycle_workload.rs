@@ -10,10 +10,9 @@
 
 use std::time::Instant;
 
-use planner::{
-    MergeRoad, Neighbour, PfPlanner, PlanRequest, PlannerKind, PlannerParams, VehicleShape,
-    VehicleState,
-};
+use mergesim_types::{MergeRoad, Neighbour, VehicleShape, VehicleState};
+use planner::params::PlannerParams;
+use planner::{PfPlanner, PlanRequest, PlannerKind};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let rounds: usize = match std::env::args().nth(1) {

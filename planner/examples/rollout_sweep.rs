@@ -12,10 +12,9 @@
 //!
 //! `cargo run --release -p planner --example rollout_sweep`
 
-use planner::{
-    Lane, MergeRoad, Neighbour, PfPlanner, PlanRequest, PlannerKind, PlannerParams,
-    SharedLocalPath, VehicleShape, VehicleState,
-};
+use mergesim_types::{Lane, MergeRoad, Neighbour, SharedLocalPath, VehicleShape, VehicleState};
+use planner::params::PlannerParams;
+use planner::{PfPlanner, PlanRequest, PlannerKind};
 
 /// Replanning period and roll-out length (s).
 const STEP_S: f64 = 0.1;

@@ -4,7 +4,8 @@ use mergesim_types::{
     Behaviour, BehaviourError, Decision, DegradedMode, GridSpec, Observation, OptimiserReport,
 };
 
-use crate::planners::{PfPlanner, PlanRequest};
+use crate::planners::PfPlanner;
+use crate::request::PlanRequest;
 
 /// The planner's request of an observation.
 fn request<'a>(obs: &Observation<'a>) -> PlanRequest<'a> {
@@ -54,7 +55,9 @@ impl Behaviour for PfPlanner {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{MergeRoad, PlannerKind, PlannerParams, VehicleShape, VehicleState};
+    use crate::PlannerKind;
+    use crate::params::PlannerParams;
+    use mergesim_types::{MergeRoad, VehicleShape, VehicleState};
 
     #[test]
     fn the_behaviour_is_the_plan_with_its_shared_path() {

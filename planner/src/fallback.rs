@@ -7,10 +7,11 @@
 //! speed falls at `fallback_decel_mps2` from the current speed:
 //! v(s) = √(max(v0² − 2 a s, 0)), reached at t(s) = (v0 − v(s)) / a.
 
+use crate::Plan;
 use crate::params::PlannerParams;
 use crate::polyline::Polyline;
-use crate::types::{
-    FallbackReason, PathPoint, Plan, SharedLocalPath, TimedWaypoint, VehicleId, VehicleShape,
+use mergesim_types::{
+    FallbackReason, PathPoint, SharedLocalPath, TimedWaypoint, VehicleId, VehicleShape,
     VehicleState,
 };
 

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::types::VehicleShape;
+use mergesim_types::VehicleShape;
 
 /// Largest |ψ_o| used in the correlation form (rad): C1 = 1 − ψ² and the correlation ψ must stay
 /// below 1 for the quadratic form to be positive definite.

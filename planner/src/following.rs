@@ -36,7 +36,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::lane_road_field::LaneRoadGeometry;
-use crate::types::{Neighbour, VehicleId, VehicleShape, VehicleState};
+use mergesim_types::{Neighbour, VehicleId, VehicleShape, VehicleState};
 
 /// What a PF-ISO vehicle does in a cycle without any fresh shared path around it (module doc).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

@@ -119,8 +119,8 @@ pub fn path_curvature_on_lane_1pm(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mergesim_types::MergeRoad;
     use mergesim_types::lanes::{LaneRoad, THROUGH_LANE_ID, curved_merge_spec};
-    use mergesim_types::road::MergeRoad;
     use std::f64::consts::PI;
 
     fn arc_road() -> LaneRoad {

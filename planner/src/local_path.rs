@@ -126,8 +126,8 @@ pub(crate) fn local_path_adaptive(
 mod tests {
     use super::*;
     use crate::params::PlannerParams;
-    use crate::road::MergeRoad;
-    use crate::types::{VehicleShape, VehicleState};
+    use mergesim_types::MergeRoad;
+    use mergesim_types::{VehicleShape, VehicleState};
 
     #[test]
     fn one_substep_is_eq_7_and_steps_have_length_ls() {
@@ -164,7 +164,7 @@ mod tests {
         // The urgent merge at t = 12 s: the follower (upper lane, 15 m/s) behind the merging
         // car, whose field squeezes its path against the road edge's wall, where 1 m sub-steps
         // bounce (ψ_ref flips between ≈ +0.5 and −1.47 rad).
-        use crate::types::Neighbour;
+        use mergesim_types::Neighbour;
         let params = PlannerParams::default();
         let merge = MergeRoad::default();
         let road = crate::lane_road_field::LaneRoadGeometry::new(&merge.lane_road().unwrap());
@@ -241,7 +241,7 @@ mod tests {
             &[],
         );
         let path = local_path(&field, [0.0, 2.4], 5.0, 20, 1.0, 0.0);
-        let centre = merge.lane_center_y_m(crate::road::Lane::Lower);
+        let centre = merge.lane_center_y_m(mergesim_types::Lane::Lower);
         let first_offset = (2.4 - centre).abs();
         let last_offset = (path[19][1] - centre).abs();
         assert!(

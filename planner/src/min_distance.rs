@@ -3,7 +3,7 @@
 //! vehicle's speed.
 
 use crate::field_params::ObstacleFieldParams;
-use crate::types::VehicleShape;
+use mergesim_types::VehicleShape;
 
 /// D_min of Eq. 4 for a follower closing on a leader (m), clamped to at least the length term:
 /// length + max(0, v_f τ + M_f v_f²/(2 a_f) − M_l v_l²/(2 a_l)).

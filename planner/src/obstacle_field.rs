@@ -36,7 +36,7 @@
 //!   With the rotation form the two half-Gaussians join with zero slope at u_x = 0 (C¹ field).
 //!   With the correlation form the side is the sign of X − X_o, where q is continuous.
 
-use crate::types::VehicleShape;
+use mergesim_types::VehicleShape;
 
 pub use crate::field_params::{
     HeadingForm, MAX_CORRELATION_HEADING_RAD, MinDistanceLength, ObstacleFieldParams, Role,

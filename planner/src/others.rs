@@ -23,12 +23,12 @@ use crate::derived_params::PlanHorizon;
 use crate::lane_road_field::LaneRoadGeometry;
 use crate::obstacle_field::HeadingForm;
 use crate::obstacle_field::{ObstacleField, ObstacleFieldParams, Role, SelfView};
-use crate::planners::PlanRequest;
 use crate::polyline::Polyline;
 use crate::prediction::{PredictionModel, Trajectory};
+use crate::request::PlanRequest;
 use crate::speed_optimisation::fixed_waypoint_term::SlotOther;
 use crate::speed_optimisation::{Aggregate, FixedWaypointTerm, InteractionTerm};
-use crate::types::{SharedLocalPath, VehicleId, VehicleShape};
+use mergesim_types::{SharedLocalPath, VehicleId, VehicleShape};
 
 /// Another vehicle as the speed terms see it.
 #[derive(Clone, Debug)]

@@ -7,8 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use mergesim_types::Bound;
-use mergesim_types::bounds;
+use mergesim_types::bounds::{self, Bound};
 
 use crate::error::PlannerError;
 use crate::following::V2vLossFallback;

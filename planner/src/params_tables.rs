@@ -14,7 +14,7 @@
 //! A planner accepts the keys of `pf` and of its own table ([`tables_of`]); a key of another
 //! planner's table is refused naming that table ([`check_key`]).
 
-use crate::planners::PlannerKind;
+use crate::planner_kind::PlannerKind;
 
 /// The table every PF planner reads (today's `[sim.planner]`, kept as its alias).
 pub const PF_TABLE: &str = "pf";
@@ -44,7 +44,7 @@ pub const PF_ISO_FIELDS: &[&str] = &[
 /// The fields of the `pf-sp` table: the weight of PF-SP's risk term.
 pub const PF_SP_FIELDS: &[&str] = &["risk_weight"];
 
-/// Every field of [`PlannerParams`](crate::PlannerParams), in declaration order (a unit test
+/// Every field of [`PlannerParams`](crate::params::PlannerParams), in declaration order (a unit test
 /// checks it against the struct's serde form).
 pub const ALL_FIELDS: &[&str] = &[
     "attractive_gain_per_m2",
@@ -166,7 +166,7 @@ pub fn check_vehicle_key(kind: PlannerKind, key: &str) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::PlannerParams;
+    use crate::params::PlannerParams;
 
     #[test]
     fn all_fields_are_the_structs_fields_and_each_is_in_one_table() {

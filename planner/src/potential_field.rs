@@ -12,7 +12,7 @@ use crate::error::PlannerError;
 use crate::lane_road_field::{LaneRoadField, LaneRoadGeometry};
 use crate::obstacle_field::{ObstacleField, ObstacleFieldParams, SelfView};
 use crate::road_field::RoadFieldParams;
-use crate::types::{Neighbour, VehicleId, VehicleShape, VehicleState};
+use mergesim_types::{Neighbour, VehicleId, VehicleShape, VehicleState};
 
 pub(crate) use mergesim_types::GridSpec;
 
@@ -231,7 +231,7 @@ mod tests {
     #[test]
     fn universal_gradient_matches_central_differences() {
         let params = UniversalFieldParams::from(&PlannerParams::default());
-        let merge = crate::road::MergeRoad::default();
+        let merge = mergesim_types::MergeRoad::default();
         let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let neighbours = [
             Neighbour {
@@ -284,11 +284,11 @@ mod tests {
     #[test]
     fn default_lane_equilibria_sit_at_the_lane_centres() {
         let params = UniversalFieldParams::from(&PlannerParams::default());
-        let merge = crate::road::MergeRoad::default();
+        let merge = mergesim_types::MergeRoad::default();
         let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = state(0.0, 1.75, 0.0, 20.0);
         let field = PotentialField::new(&params, &road, 0, &ego, &VehicleShape::default(), &[]);
-        for lane in [crate::road::Lane::Lower, crate::road::Lane::Upper] {
+        for lane in [mergesim_types::Lane::Lower, mergesim_types::Lane::Upper] {
             let centre = merge.lane_center_y_m(lane);
             let fy = |y: f64| field.stepping_force(50.0, y)[1];
             let (mut lo, mut hi) = (centre - 0.6, centre + 0.6);
@@ -304,7 +304,7 @@ mod tests {
     #[test]
     fn own_entry_among_neighbours_is_skipped() {
         let params = UniversalFieldParams::from(&PlannerParams::default());
-        let merge = crate::road::MergeRoad::default();
+        let merge = mergesim_types::MergeRoad::default();
         let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = state(0.0, 1.75, 0.0, 20.0);
         let neighbours = [Neighbour {
@@ -326,7 +326,7 @@ mod tests {
     #[test]
     fn grid_samples_cell_centres_row_after_row() {
         let params = UniversalFieldParams::from(&PlannerParams::default());
-        let merge = crate::road::MergeRoad::default();
+        let merge = mergesim_types::MergeRoad::default();
         let road = LaneRoadGeometry::new(&merge.lane_road().unwrap());
         let ego = state(0.0, 1.75, 0.0, 20.0);
         let field = PotentialField::new(&params, &road, 0, &ego, &VehicleShape::default(), &[]);

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use mergesim_types::lanes::{LaneRoad, Side};
 
 use crate::lane_road_field::LaneRoadGeometry;
-use crate::types::{SharedLocalPath, TimedWaypoint, VehicleState};
+use mergesim_types::{SharedLocalPath, TimedWaypoint, VehicleState};
 
 /// How a vehicle without a fresh shared path is predicted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -279,7 +279,7 @@ impl Trajectory {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::types::VehicleShape;
+    use mergesim_types::VehicleShape;
 
     #[test]
     fn shared_path_is_interpolated_and_extrapolated_in_time() {
@@ -321,7 +321,7 @@ mod tests {
 
     #[test]
     fn lane_following_keeps_the_lane_and_merges_with_the_taper() {
-        let road = crate::road::MergeRoad::default();
+        let road = mergesim_types::MergeRoad::default();
         let geometry = LaneRoadGeometry::new(&road.lane_road().unwrap());
         // An upper-lane car slightly yawed: stays at its lateral position along the road.
         let upper = VehicleState {
@@ -340,7 +340,7 @@ mod tests {
         // on the through lane's centre after the merge section.
         let lower = VehicleState {
             x_m: 100.0,
-            y_m: road.lane_center_y_m(crate::road::Lane::Lower),
+            y_m: road.lane_center_y_m(mergesim_types::Lane::Lower),
             yaw_rad: 0.0,
             speed_mps: 20.0,
         };
@@ -352,7 +352,7 @@ mod tests {
         assert!((mid.xy_m[1] - expected).abs() < 1e-9 && mid.xy_m[1] > lower.y_m);
         assert!(mid.heading[1] > 0.0, "heading along the taper");
         let after = t.pose_at((road.merge_end_x_m + 20.0 - 100.0) / 20.0);
-        let upper_centre = road.lane_center_y_m(crate::road::Lane::Upper);
+        let upper_centre = road.lane_center_y_m(mergesim_types::Lane::Upper);
         assert!((after.xy_m[1] - upper_centre).abs() < 1e-9);
     }
 

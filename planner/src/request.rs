@@ -1,7 +1,7 @@
 //! The input of one planning cycle and its validation (every number finite, shapes positive).
 
 use crate::error::PlannerError;
-use crate::types::{Neighbour, SharedLocalPath, VehicleId, VehicleShape, VehicleState};
+use mergesim_types::{Neighbour, SharedLocalPath, VehicleId, VehicleShape, VehicleState};
 
 /// The input of one planning cycle.
 #[derive(Clone, Copy, Debug)]

@@ -13,7 +13,7 @@
 //!   the field is C¹, finite everywhere, and still pushes back on and beyond the edge.
 //! - The divider (Eq. 2) exists while two lanes exist, `MergeRoad::has_divider`.
 
-use crate::road::MergeRoad;
+use mergesim_types::MergeRoad;
 
 /// The numbers of the road terms, Eqs. 2–3, shared by [`RoadField`] and the planners'
 /// `LaneRoadField`; built once from `PlannerParams` (`derived_params`).

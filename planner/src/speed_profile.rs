@@ -5,8 +5,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::Plan;
 use crate::error::PlannerError;
-use crate::types::{PathPoint, Plan, SharedLocalPath};
+use mergesim_types::{PathPoint, SharedLocalPath};
 
 /// Slowest speed a profile may prescribe (m/s): a standstill (stop and go, `stop_and_go`).
 pub const MIN_PROFILE_SPEED_MPS: f64 = 0.0;
@@ -193,7 +194,7 @@ impl Plan {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::types::{PathPoint, SharedLocalPath, VehicleShape};
+    use mergesim_types::{PathPoint, SharedLocalPath, VehicleShape};
 
     fn profile() -> SpeedProfile {
         SpeedProfile {

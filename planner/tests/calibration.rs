@@ -7,7 +7,8 @@
 
 mod common;
 
-use planner::{PlannerKind, PlannerParams};
+use planner::PlannerKind;
+use planner::params::PlannerParams;
 
 /// Lane-centring tolerance: a path's lateral equilibrium stays this close to where it is
 /// without the neighbour (m).

@@ -6,10 +6,13 @@ use std::sync::Arc;
 use mergesim_types::lanes::{
     ENDING_LANE_ID, LaneRoad, LaneRoadSpec, THROUGH_LANE_ID, curved_merge_spec,
 };
+use mergesim_types::{MergeRoad, Neighbour, SharedLocalPath, VehicleShape, VehicleState};
 use planner::lane_road_field::LaneRoadGeometry;
 use planner::obstacle_field::HeadingForm;
+use planner::params::PlannerParams;
+use planner::potential_field::PotentialField;
 use planner::potential_field::UniversalFieldParams;
-use planner::*;
+use planner::{ParameterSet, PfPlanner, PlanRequest, PlannerKind};
 
 fn state(x_m: f64, y_m: f64, yaw_rad: f64, speed_mps: f64) -> VehicleState {
     VehicleState {

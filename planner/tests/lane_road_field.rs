@@ -6,11 +6,12 @@ use mergesim_types::lanes::{
     ENDING_LANE_ID, LaneRoad, LaneRoadSpec, OnRampParams, THROUGH_LANE_ID, curved_merge_spec,
     on_ramp_ids, on_ramp_spec,
 };
+use mergesim_types::{MergeRoad, VehicleShape};
 use planner::attractive_field::{AttractionParams, AttractiveField};
 use planner::lane_frame::lane_relative_heading_rad;
 use planner::lane_road_field::{LaneAttraction, LaneRoadField, LaneRoadGeometry};
+use planner::params::PlannerParams;
 use planner::road_field::{RoadField, RoadFieldParams};
-use planner::{MergeRoad, PlannerParams, VehicleShape};
 
 fn half_width_m() -> f64 {
     0.5 * VehicleShape::default().width_m

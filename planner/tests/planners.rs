@@ -1,8 +1,13 @@
 //! Behaviour of the planners through the public API.
 
+use mergesim_types::{
+    FallbackReason, Lane, MergeRoad, Neighbour, SharedLocalPath, TimedWaypoint, VehicleShape,
+    VehicleState,
+};
 use planner::cubic_fit::CubicPath;
 use planner::params::GRAVITY_MPS2;
-use planner::*;
+use planner::params::PlannerParams;
+use planner::{PfPlanner, Plan, PlanRequest, PlannerError, PlannerKind};
 
 fn state(x_m: f64, y_m: f64, yaw_rad: f64, speed_mps: f64) -> VehicleState {
     VehicleState {

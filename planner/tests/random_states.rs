@@ -1,7 +1,9 @@
 //! Property test: random (but finite) states never panic, never return an error, and always
 //! give a finite plan whose speeds respect the bounds.
 
-use planner::*;
+use mergesim_types::{MergeRoad, Neighbour, VehicleShape, VehicleState};
+use planner::params::PlannerParams;
+use planner::{PfPlanner, PlanRequest, PlannerKind};
 use proptest::prelude::*;
 
 fn vehicle() -> impl Strategy<Value = VehicleState> {

@@ -7,9 +7,11 @@ use std::sync::{Arc, Mutex};
 
 use mergesim_types::VehicleId;
 use pyo3::prelude::*;
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
+use sim::config::Driver;
 use sim::recording::Recorder;
-use sim::{BehaviourRegistry, Driver, RunOptions, SimError, TickObserver, World};
+use sim::registry::BehaviourRegistry;
+use sim::{RunOptions, SimError, TickObserver, World};
 
 use crate::errors::BindingError;
 use crate::external::{Command, EXTERNAL_PLANNER, External, SharedCommand};
@@ -160,10 +162,10 @@ impl EnvCore {
         registry
             .register(
                 EXTERNAL_PLANNER,
-                Arc::new(move |_: &sim::FactoryInput<'_>| {
+                Arc::new(move |_: &sim::registry::FactoryInput<'_>| {
                     Ok(Box::new(External {
                         command: shared.clone(),
-                    }) as Box<dyn sim::Behaviour>)
+                    }) as Box<dyn mergesim_types::Behaviour>)
                 }),
             )
             .map_err(|e| BindingError::input(&e))?;
@@ -201,11 +203,12 @@ impl EnvCore {
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner) = Command {
             target_speed_mps: agent_spec.target_speed_mps,
-            target_y_m: instance
-                .sim
-                .road
-                .lane_center_y_m(agent_spec.lane.merge_lane().unwrap_or(sim::Lane::Lower))
-                + agent_spec.y_offset_m,
+            target_y_m: instance.sim.road.lane_center_y_m(
+                agent_spec
+                    .lane
+                    .merge_lane()
+                    .unwrap_or(mergesim_types::Lane::Lower),
+            ) + agent_spec.y_offset_m,
         };
         *self
             .contacts

@@ -4,7 +4,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use sim::{Behaviour, BehaviourError, Decision, Observation, PathPoint};
+use mergesim_types::{Behaviour, BehaviourError, Decision, Observation, PathPoint};
 
 /// Name the behaviour is registered under (for the agent's vehicle only).
 pub(crate) const EXTERNAL_PLANNER: &str = "external";

@@ -26,7 +26,8 @@ use mergesim_types::{
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
-use sim::{BehaviourRegistry, FactoryInput, SimError};
+use sim::SimError;
+use sim::registry::{BehaviourRegistry, FactoryInput};
 
 use crate::errors::BindingError;
 use crate::external::EXTERNAL_PLANNER;

@@ -1,7 +1,8 @@
 //! Where a scenario comes from: a built-in name, a path, or TOML text; optionally with a table
 //! of overrides merged over it (`params=` in Python).
 
-use scenarios::{Scenario, builtin, scenario::MAX_SCENARIO_BYTES};
+use scenarios::scenario::Scenario;
+use scenarios::{builtin, scenario::MAX_SCENARIO_BYTES};
 
 use crate::errors::BindingError;
 

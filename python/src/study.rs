@@ -4,7 +4,9 @@
 
 use std::path::Path;
 
-use mergesim::study::{RunOptions, StudyError, StudyPlan, run_and_report};
+use mergesim::study::plan::StudyPlan;
+use mergesim::study::run_and_report;
+use mergesim::study::runner::{RunOptions, StudyError};
 use pyo3::prelude::*;
 
 use crate::background::run_interruptible;

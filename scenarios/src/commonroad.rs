@@ -1,6 +1,6 @@
 //! A CommonRoad file as a scenario (`--scenario FILE.xml`; docs/commonroad.md):
 //!
-//! - **road**: the lanelet network ([`sim::CommonRoadRoad`]), lanelet ids as lane ids, in the
+//! - **road**: the lanelet network ([`sim::road_config::CommonRoadRoad`]), lanelet ids as lane ids, in the
 //!   file's coordinates;
 //! - **recorded traffic** ([`recorded_traffic`]): every dynamic obstacle (its initial state and
 //!   trajectory in replay form) and every static obstacle (its initial state, held for the whole
@@ -20,9 +20,10 @@ use std::path::{Path, PathBuf};
 
 use mergesim_commonroad::model::{self, Position, Shape, Value};
 use mergesim_types::lanes::{LaneId, LaneRoad};
+use sim::config::{Driver, SimConfig, VehicleSpec};
 use sim::goal::{Goal, GoalPosition, GoalShape, GoalState, Interval};
 use sim::recorded_traffic::{RecordedState, RecordedTraffic, RecordedVehicle, TrafficMode};
-use sim::{CommonRoadRoad, Driver, LaneRoadConfig, SimConfig, StartLane, VehicleSpec};
+use sim::road_config::{CommonRoadRoad, LaneRoadConfig, StartLane};
 
 use crate::scenario::{Line, Scenario, ScenarioError};
 
@@ -428,7 +429,7 @@ impl Scenario {
                 ..defaults
             },
             vehicles: vec![ego],
-            randomise: crate::Randomisation::default(),
+            randomise: crate::randomisation::Randomisation::default(),
             planner_overrides: toml::Table::new(),
             source: None,
         };

@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use sim::recorded_traffic::TrafficMode;
-use sim::{CommonRoadRoad, LaneRoadConfig};
+use sim::road_config::{CommonRoadRoad, LaneRoadConfig};
 
 use crate::scenario::{Line, Scenario, ScenarioError};
 use crate::source_location::line_of;

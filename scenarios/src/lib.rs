@@ -1,18 +1,22 @@
 //! Scenario definitions: the TOML format, validation, randomisation and the built-in scenarios.
 //!
-//! A scenario is a `[sim]` table (a [`sim::SimConfig`]), a list of `[[vehicles]]`
-//! ([`sim::VehicleSpec`]) and an optional `[randomise]` table ([`Randomisation`]) of the ranges
-//! a Monte-Carlo sweep draws instances from. Unknown keys are rejected; every number is
-//! range-checked, for the nominal values and for every instance the ranges allow; errors name
-//! the file, the line and the field.
+//! A scenario is a `[sim]` table (a [`sim::config::SimConfig`]), a list of `[[vehicles]]`
+//! ([`sim::config::VehicleSpec`]) and an optional `[randomise]` table
+//! ([`randomisation::Randomisation`]) of the ranges a Monte-Carlo sweep draws instances from.
+//! Unknown keys are rejected; every number is range-checked, for the nominal values and for
+//! every instance the ranges allow; errors name the file, the line and the field.
 //!
 //! # Public API
-//! - [`Scenario`]: a scenario read from TOML ([`ScenarioSource`] says where from), validated,
-//!   with its errors [`ScenarioError`] (naming the file, line and field, [`source_location`]).
-//! - [`Randomisation`] and [`VehicleRandomisation`]: the ranges a sweep draws instances from,
-//!   as [`Distribution`]s ([`NormalOffset`]).
+//! - [`scenario::Scenario`]: a scenario read from TOML ([`scenario::ScenarioSource`] says where
+//!   from), validated, with its errors [`scenario::ScenarioError`] (naming the file, line and
+//!   field, [`source_location`]).
+//! - [`randomisation::Randomisation`] and [`randomisation::VehicleRandomisation`]: the ranges a
+//!   sweep draws instances from, as [`Distribution`]s ([`NormalOffset`]).
 //! - The built-in scenarios ([`builtin`]) and generated platoons ([`platoon`]); the scenario
 //!   module itself, [`scenario`], and the randomisation module, [`randomisation`].
+//!
+//! Each item has one path: a public module holding more than what the crate root names is
+//! the path of its items (`scenarios::scenario::Scenario`).
 #![warn(missing_docs)]
 
 pub mod builtin;
@@ -27,5 +31,3 @@ pub mod scenario;
 pub mod source_location;
 
 pub use distribution::{Distribution, NormalOffset};
-pub use randomisation::{Randomisation, VehicleRandomisation};
-pub use scenario::{Scenario, ScenarioError, ScenarioSource};

@@ -28,8 +28,8 @@
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
+use sim::config::{SimConfig, VehicleSpec};
 use sim::rng::SplitMix64;
-use sim::{SimConfig, VehicleSpec};
 
 use crate::distribution::Distribution;
 

@@ -4,9 +4,12 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use planner::{Lane, ParameterSet, PlannerParams};
+use mergesim_types::Lane;
+use planner::ParameterSet;
+use planner::params::PlannerParams;
 use serde::{Deserialize, Serialize};
-use sim::{SimConfig, SimError, VehicleSpec};
+use sim::SimError;
+use sim::config::{SimConfig, VehicleSpec};
 use thiserror::Error;
 
 use crate::builtin;
@@ -244,7 +247,7 @@ impl Scenario {
         scenario
             .check(origin, Some(text))
             .map_err(|e| crate::commonroad_toml::aliased(e, &scenario, &table, text))?;
-        scenario.check_planner_tables(&sim::BehaviourRegistry::builtin(), true)?;
+        scenario.check_planner_tables(&sim::registry::BehaviourRegistry::builtin(), true)?;
         Ok(scenario)
     }
 
@@ -256,7 +259,7 @@ impl Scenario {
         let origin = format!("{} with --params {set}", self.name);
         scenario.apply_parameter_set(&origin, None)?;
         scenario.check(&origin, None)?;
-        scenario.check_planner_tables(&sim::BehaviourRegistry::builtin(), true)?;
+        scenario.check_planner_tables(&sim::registry::BehaviourRegistry::builtin(), true)?;
         Ok(scenario)
     }
 
@@ -335,7 +338,8 @@ impl Scenario {
             }
         };
         self.sim.validate().map_err(|e| sim_error(e, "", None))?;
-        sim::validate_vehicles(&self.sim, &self.vehicles).map_err(|e| sim_error(e, "", None))?;
+        sim::config::validate_vehicles(&self.sim, &self.vehicles)
+            .map_err(|e| sim_error(e, "", None))?;
         self.randomise
             .check_entries(&self.vehicles)
             .map_err(|issue| ScenarioError::Invalid {
@@ -365,7 +369,7 @@ impl Scenario {
                 sim_error(e, &prefix, entry)
             };
             sim_c.validate().map_err(corner_error)?;
-            sim::validate_vehicles(&sim_c, &vehicles_c).map_err(corner_error)?;
+            sim::config::validate_vehicles(&sim_c, &vehicles_c).map_err(corner_error)?;
         }
         self.check_geometry(origin, &at)
     }
@@ -477,7 +481,7 @@ impl Scenario {
             // duration at the highest speed it starts at, aims at or is prescribed, plus
             // ROAD_END_SPEED_ALLOWANCE for overshoot, stays on it.
             let prescribed_max_mps = match &v.driver {
-                sim::Driver::Prescribed { speed_profile, .. } => speed_profile
+                sim::config::Driver::Prescribed { speed_profile, .. } => speed_profile
                     .points
                     .iter()
                     .map(|p| p[1])

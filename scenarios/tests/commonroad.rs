@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use mergesim_types::lanes::LaneId;
-use scenarios::{Scenario, ScenarioError};
+use scenarios::scenario::{Scenario, ScenarioError};
 use sim::goal::GoalPosition;
 use sim::recorded_traffic::TrafficMode;
 

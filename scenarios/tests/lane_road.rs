@@ -4,7 +4,7 @@
 
 use mergesim_types::MergeRoad;
 use mergesim_types::lanes::LaneId;
-use scenarios::{Scenario, ScenarioError};
+use scenarios::scenario::{Scenario, ScenarioError};
 
 /// The urgent merge with its road written out as lanes: exactly the lanes
 /// `MergeRoad::lane_road` builds for the default `[sim.road]`, vehicles at the same places (the

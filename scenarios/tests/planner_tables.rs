@@ -5,9 +5,10 @@
 
 use std::sync::Arc;
 
-use scenarios::{Scenario, ScenarioError};
+use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
+use scenarios::scenario::{Scenario, ScenarioError};
 use sim::registry::{BehaviourRegistry, FactoryInput};
-use sim::{Behaviour, BehaviourError, Decision, Observation, ParamsError, PlannerParameters};
+use sim::{ParamsError, PlannerParameters};
 
 const URGENT: &str = include_str!("../builtin/urgent_merge.toml");
 const EGO_DRIVER: &str = "driver = { planner = \"pf-iso\" }";
@@ -152,7 +153,9 @@ fn a_vehicle_s_params_give_its_planner_its_own_values() {
         .parse_params("pf-iso", &scenario.sim, Some(own))
         .unwrap()
         .unwrap();
-    let params = parsed.downcast_ref::<planner::PlannerParams>().unwrap();
+    let params = parsed
+        .downcast_ref::<planner::params::PlannerParams>()
+        .unwrap();
     assert_eq!(params.interaction_weight, 6.0);
     assert_eq!(params.waypoint_count, 16);
     assert_eq!(params.step_time_s, scenario.sim.planner.step_time_s);

@@ -4,7 +4,8 @@
 
 use mergesim_types::lanes::{LaneId, LaneRoad};
 use mergesim_types::{Behaviour, PathPoint, VehicleId, VehicleShape};
-use vehicles::{Tracker, Vehicle, VehicleParams};
+use vehicles::tracker::Tracker;
+use vehicles::{Vehicle, VehicleParams};
 
 use crate::config::{Driver, SimConfig, VehicleSpec};
 use crate::drivers::{IdmDriver, LaneKeeping, PrescribedSpeed};

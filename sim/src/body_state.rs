@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use planner::VehicleId;
+use mergesim_types::VehicleId;
 
 /// Pose, velocity and footprint of a vehicle body at one instant (world frame, SI units).
 ///

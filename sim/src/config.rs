@@ -4,12 +4,13 @@ mod driver;
 
 use std::collections::BTreeMap;
 
-use planner::{MergeRoad, PlannerParams};
+use mergesim_types::MergeRoad;
+use planner::params::PlannerParams;
 use serde::{Deserialize, Serialize};
-use vehicles::TrackerParams;
+use vehicles::tracker::TrackerParams;
 
+use mergesim_types::bounds::{self, Bound};
 use mergesim_types::lanes::LaneId;
-use mergesim_types::{Bound, bounds};
 
 pub use driver::Driver;
 

@@ -16,7 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use mergesim_types::{Bound, bounds};
+use mergesim_types::bounds::{self, Bound};
 
 use crate::error::SimError;
 

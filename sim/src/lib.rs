@@ -3,20 +3,27 @@
 //! recording), the simulator's own drivers and the registry of planners by name.
 //!
 //! # Public API
-//! - A run: [`World`] built from a [`SimConfig`] and its [`VehicleSpec`]s (checked by
-//!   [`validate_vehicles`]), run with [`RunOptions`] to a [`RunOutcome`] (with
-//!   [`TimeSeriesRow`]s, [`RecordedPose`]s, [`PlannerStats`]) or a [`SimError`].
-//! - The road: [`LaneRoadConfig`] ([`StartLane`]), a CommonRoad map [`CommonRoadRoad`], recorded
-//!   traffic ([`recorded_traffic`]), routes ([`route`]), goals ([`goal`]) and the drawing of a
-//!   road ([`road_drawing`]).
-//! - Who drives: each vehicle's [`Driver`]; planners by name in a [`BehaviourRegistry`] of
-//!   [`BehaviourFactory`]s (given a [`FactoryInput`]), with their parameter tables
-//!   ([`PlannerParameters`], [`ParamsTable`], [`ParamsError`]); the simulator's own drivers
-//!   ([`drivers`], [`idm`]).
+//! - A run: [`World`] built from a [`config::SimConfig`] and its [`config::VehicleSpec`]s
+//!   (checked by [`config::validate_vehicles`]), run with [`RunOptions`] to a [`RunOutcome`]
+//!   (with [`TimeSeriesRow`]s, [`RecordedPose`]s, [`PlannerStats`]) or a [`SimError`].
+//! - The road: [`road_config`] ([`road_config::LaneRoadConfig`], [`road_config::StartLane`], a
+//!   CommonRoad map [`road_config::CommonRoadRoad`]), recorded traffic ([`recorded_traffic`]),
+//!   routes ([`route`]), goals ([`goal`]) and the drawing of a road ([`road_drawing`]).
+//! - Who drives: each vehicle's [`config::Driver`]; planners by name in a
+//!   [`registry::BehaviourRegistry`] of [`registry::BehaviourFactory`]s (given a
+//!   [`registry::FactoryInput`]), with their parameter tables ([`PlannerParameters`],
+//!   [`ParamsTable`], [`ParamsError`]); the simulator's own drivers ([`drivers`], [`idm`]).
 //! - Watching a run: a [`TickObserver`] sees [`VehicleView`]s, [`PlanView`]s and
 //!   [`SimEvent`]s; metrics ([`metrics`], [`paper_metrics`]), safety checks ([`safety`]), the
 //!   V2V bus ([`v2v`]), phase timings ([`profile`]) and Rerun recordings ([`recording`]).
 //! - Helpers: the seeded generator [`rng`] and the neighbour search [`spatial`].
+//! - The plain data and the interface every driver implements ([`Behaviour`](mergesim_types::Behaviour),
+//!   [`Observation`](mergesim_types::Observation), [`Decision`](mergesim_types::Decision), roads
+//!   made of lanes [`lanes`](mergesim_types::lanes)) are [`mergesim_types`]': spelled
+//!   `mergesim_types::Behaviour` and so on (the simulator does not re-export them).
+//!
+//! Each item has one path: a module is public when it holds more than what the crate root
+//! names, and then its items are reached through it (`sim::config::SimConfig`).
 #![warn(missing_docs)]
 
 pub(crate) mod agent;
@@ -50,18 +57,9 @@ pub mod spatial;
 pub mod v2v;
 pub(crate) mod world;
 
-pub use config::{Driver, SimConfig, VehicleSpec, validate_vehicles};
 pub use error::SimError;
 pub use event::SimEvent;
-/// Roads made of lanes (what `Observation::lanes` is): re-exported for planners written against
-/// the simulator.
-pub use mergesim_types::lanes;
-pub use mergesim_types::{
-    Behaviour, BehaviourError, Decision, Lane, MergeRoad, Observation, PathPoint, VehicleId,
-};
 pub use observer::{PlanView, TickObserver, VehicleView};
 pub use outcome::{PlannerStats, RecordedPose, RunOutcome, TimeSeriesRow};
 pub use planner_params::{ParamsError, ParamsTable, PlannerParameters};
-pub use registry::{BehaviourFactory, BehaviourRegistry, FactoryInput};
-pub use road_config::{CommonRoadRoad, LaneRoadConfig, StartLane};
 pub use world::{RunOptions, World};

@@ -7,7 +7,7 @@
 //! says `#[serde(deny_unknown_fields)]`; missing keys take `P::default()`'s values if `P` says
 //! `#[serde(default)]`), checked by [`PlannerParameters::validate`], and the value reaches its
 //! factory. A planner registered without a type refuses any non-empty table. The built-in
-//! potential-field planners read their tables into the one `planner::PlannerParams`
+//! potential-field planners read their tables into the one `planner::params::PlannerParams`
 //! (`planner::params_tables`).
 //!
 //! [`BehaviourRegistry::register_with_params`]: crate::registry::BehaviourRegistry::register_with_params

@@ -7,14 +7,14 @@
 //! ```
 //! use std::sync::Arc;
 //! use sim::registry::{BehaviourRegistry, FactoryInput};
-//! use sim::{Behaviour, BehaviourError, Decision, Observation};
+//! use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
 //!
 //! struct Cruise;
 //! impl Behaviour for Cruise {
 //!     fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError> {
 //!         let v = obs.target_speed_mps;
 //!         let path = (0..=10)
-//!             .map(|i| sim::PathPoint {
+//!             .map(|i| mergesim_types::PathPoint {
 //!                 x_m: obs.ego.x_m + 5.0 * i as f64,
 //!                 y_m: obs.ego.y_m,
 //!                 speed_mps: v,
@@ -42,7 +42,8 @@
 //! ```
 //! use std::sync::Arc;
 //! use sim::registry::{BehaviourRegistry, FactoryInput};
-//! use sim::{Behaviour, BehaviourError, Decision, Observation, ParamsError, PlannerParameters};
+//! use sim::{ParamsError, PlannerParameters};
+//! use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
 //!
 //! #[derive(Debug, Default, serde::Deserialize)]
 //! #[serde(deny_unknown_fields, default)]
@@ -76,8 +77,9 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
+use planner::params::PlannerParams;
 use planner::params_tables::{self, PF_TABLES};
-use planner::{PfPlanner, PlannerKind, PlannerParams};
+use planner::{PfPlanner, PlannerKind};
 
 use crate::config::{SimConfig, VehicleSpec};
 use crate::error::SimError;
@@ -97,7 +99,7 @@ pub struct FactoryInput<'a> {
     pub lanes: &'a Arc<mergesim_types::lanes::LaneRoad>,
     /// The vehicle's planner parameters, parsed and validated by the planner's schema (module
     /// doc): a `P` for a planner registered with `register_with_params::<P>`; for a built-in PF
-    /// planner a `planner::PlannerParams` when the vehicle has its own (`None`: the
+    /// planner a `planner::params::PlannerParams` when the vehicle has its own (`None`: the
     /// scenario's `config.planner`); `None` for a planner without parameters.
     pub params: Option<&'a (dyn std::any::Any + Send + Sync)>,
 }

@@ -16,10 +16,10 @@
 
 use std::collections::BTreeMap;
 
-use planner::{SharedLocalPath, VehicleId};
+use mergesim_types::{SharedLocalPath, VehicleId};
 use serde::{Deserialize, Serialize};
 
-use mergesim_types::{Bound, bounds};
+use mergesim_types::bounds::{self, Bound};
 
 use crate::error::SimError;
 use crate::rng::SplitMix64;
@@ -282,7 +282,7 @@ fn is_fresh(stamp_s: f64, t_s: f64, stale_after_s: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use planner::{TimedWaypoint, VehicleShape};
+    use mergesim_types::{TimedWaypoint, VehicleShape};
 
     fn msg(id: VehicleId, stamp_s: f64) -> SharedLocalPath {
         SharedLocalPath {

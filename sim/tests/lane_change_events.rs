@@ -5,12 +5,12 @@
 use std::sync::Arc;
 
 use mergesim_types::lanes::{LaneId, LaneRoad};
+use mergesim_types::{Behaviour, BehaviourError, Decision, Lane, Observation, PathPoint};
+use sim::config::{Driver, SimConfig, VehicleSpec};
 use sim::recording::Recorder;
+use sim::registry::{BehaviourRegistry, FactoryInput};
 use sim::road_config::{CurvedMergeConfig, LaneRoadConfig};
-use sim::{
-    Behaviour, BehaviourError, BehaviourRegistry, Decision, Driver, FactoryInput, Lane,
-    Observation, PathPoint, RunOptions, SimConfig, VehicleSpec, World,
-};
+use sim::{RunOptions, World};
 
 /// Follows the upper lane's centre, weaves to the lower lane's centre between s = 40 and 60 m
 /// (of the upper lane), holds it to 110 m and weaves back by 130 m: the path is the upper lane's

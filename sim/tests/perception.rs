@@ -4,11 +4,13 @@
 use std::collections::BTreeSet;
 use std::sync::{Arc, Mutex};
 
-use sim::recording::Recorder;
-use sim::{
-    Behaviour, BehaviourError, BehaviourRegistry, Decision, Driver, FactoryInput, Lane,
-    Observation, PathPoint, RunOptions, SimConfig, VehicleId, VehicleSpec, World,
+use mergesim_types::{
+    Behaviour, BehaviourError, Decision, Lane, Observation, PathPoint, VehicleId,
 };
+use sim::config::{Driver, SimConfig, VehicleSpec};
+use sim::recording::Recorder;
+use sim::registry::{BehaviourRegistry, FactoryInput};
+use sim::{RunOptions, World};
 
 /// What one vehicle was given over the run: neighbour ids and shared-path sender ids.
 #[derive(Debug, Default)]

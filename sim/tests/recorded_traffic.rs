@@ -5,13 +5,13 @@
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
+use mergesim_types::{Behaviour, BehaviourError, Decision, Lane, Observation, VehicleId};
+use sim::config::{Driver, SimConfig, VehicleSpec};
 use sim::idm::{IdmParams, desired_gap_m};
 use sim::recorded_traffic::{RecordedState, RecordedTraffic, RecordedVehicle, TrafficMode};
 use sim::recording::Recorder;
-use sim::{
-    Behaviour, BehaviourError, BehaviourRegistry, Decision, Driver, FactoryInput, Lane,
-    Observation, RunOptions, RunOutcome, SimConfig, VehicleId, VehicleSpec, World,
-};
+use sim::registry::{BehaviourRegistry, FactoryInput};
+use sim::{RunOptions, RunOutcome, World};
 
 /// Upper lane centre of the default merge road (m).
 const UPPER_Y_M: f64 = 5.25;
@@ -539,9 +539,9 @@ fn recorded_traffic_works_on_a_turned_lane_road_far_from_the_origin() {
     };
     let config = SimConfig {
         duration_s: 5.0,
-        lane_road: Some(sim::LaneRoadConfig {
+        lane_road: Some(sim::road_config::LaneRoadConfig {
             lanes: vec![lane],
-            ..sim::LaneRoadConfig::default()
+            ..sim::road_config::LaneRoadConfig::default()
         }),
         recorded_traffic: RecordedTraffic {
             mode: TrafficMode::Replay,

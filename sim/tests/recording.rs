@@ -5,7 +5,7 @@ use std::collections::BTreeSet;
 use std::io::BufReader;
 use std::path::PathBuf;
 
-use planner::{MergeRoad, PathPoint, SharedLocalPath, TimedWaypoint, VehicleShape};
+use mergesim_types::{MergeRoad, PathPoint, SharedLocalPath, TimedWaypoint, VehicleShape};
 use re_log_encoding::DecoderApp;
 use rerun::StoreKind;
 use rerun::log::{Chunk, LogMsg};

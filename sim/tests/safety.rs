@@ -3,7 +3,7 @@
 
 use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_4, PI};
 
-use planner::MergeRoad;
+use mergesim_types::MergeRoad;
 use sim::safety::{BodyState, RoadEdge, SafetyError, SafetyMonitor, SafetyParams};
 
 /// The road as lanes, as the world hands it to the monitor.
@@ -333,7 +333,7 @@ fn upper_edge_and_off_road_boxes_are_edge_contacts() {
                 car(
                     0,
                     50.0,
-                    road.lane_center_y_m(planner::Lane::Lower),
+                    road.lane_center_y_m(mergesim_types::Lane::Lower),
                     0.0,
                     20.0,
                     0.0,
@@ -341,7 +341,7 @@ fn upper_edge_and_off_road_boxes_are_edge_contacts() {
                 car(
                     1,
                     80.0,
-                    road.lane_center_y_m(planner::Lane::Upper),
+                    road.lane_center_y_m(mergesim_types::Lane::Upper),
                     0.0,
                     20.0,
                     0.0,

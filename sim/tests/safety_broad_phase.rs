@@ -2,7 +2,7 @@
 //! reports at every instant and an identical summary, on crowded layouts with contacts, near
 //! misses, closing pairs, pairs beyond the followed range and vehicles side by side.
 
-use planner::MergeRoad;
+use mergesim_types::MergeRoad;
 use sim::rng::SplitMix64;
 use sim::safety::{BodyState, SafetyMonitor, SafetyParams, SafetySummary};
 

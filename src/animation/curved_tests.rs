@@ -10,8 +10,8 @@ use crate::plots::ensure_font;
 const EDGE_RGB: [u8; 3] = [230, 230, 230];
 
 fn curved() -> LaneRoad {
-    let spec =
-        curved_merge_spec(&sim::MergeRoad::default(), 300.0).unwrap_or_else(|e| panic!("{e}"));
+    let spec = curved_merge_spec(&mergesim_types::MergeRoad::default(), 300.0)
+        .unwrap_or_else(|e| panic!("{e}"));
     LaneRoad::new(&spec).unwrap_or_else(|e| panic!("{e}"))
 }
 

@@ -52,7 +52,7 @@ fn a_diagonal_road_is_turned_to_run_to_the_right() {
         assert!((y0 - y1).abs() <= 1, "{y0} {y1}");
     }
     // The straight merge road keeps its unturned picture.
-    let merge = sim::MergeRoad::default()
+    let merge = mergesim_types::MergeRoad::default()
         .lane_road()
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(road_view_rotation_rad(&merge), 0.0);

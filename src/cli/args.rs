@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 use planner::ParameterSet;
-use sim::BehaviourRegistry;
+use sim::registry::BehaviourRegistry;
 
 /// Cooperative merge simulator: potential-field planners with interactive speed optimisation
 /// (Lin et al.) on physics-based Rapier vehicles.

@@ -4,7 +4,7 @@ use std::io::IsTerminal;
 use std::path::Path;
 
 use anyhow::anyhow;
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
 
 use crate::output::{check_distinct, check_output_path};

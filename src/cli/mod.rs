@@ -7,7 +7,7 @@
 //!
 //! ```no_run
 //! fn main() -> std::process::ExitCode {
-//!     let registry = mergesim::sim::BehaviourRegistry::builtin();
+//!     let registry = mergesim::sim::registry::BehaviourRegistry::builtin();
 //!     // registry.register("my-planner", factory)?  (see examples/own_planner_cli.rs)
 //!     mergesim::cli::main_with(registry)
 //! }
@@ -37,7 +37,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 use anyhow::Context;
-use sim::BehaviourRegistry;
+use sim::registry::BehaviourRegistry;
 
 use crate::cli::args::Command;
 use crate::output::write_atomically;

@@ -12,7 +12,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow};
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 
 use crate::animation::{GifParams, GifView};
 use crate::cli::args::RunArgs;
@@ -61,7 +61,10 @@ struct RunJob<'a> {
 }
 
 /// Step 1: loads the scenario and resolves every argument.
-fn load<'a>(args: &'a RunArgs, registry: &sim::BehaviourRegistry) -> Result<RunJob<'a>, Failure> {
+fn load<'a>(
+    args: &'a RunArgs,
+    registry: &sim::registry::BehaviourRegistry,
+) -> Result<RunJob<'a>, Failure> {
     let scenario = load_source(&args.source, registry)?;
     if !cfg!(feature = "rerun") && (args.rrd.is_some() || args.view) {
         return Err(input(anyhow!(

@@ -4,7 +4,7 @@
 
 use anyhow::Context;
 use planner::ParameterSet;
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use sim::recording::{Recorder, RecorderParams};
 
 use crate::cli::{Failure, Session, args, input, interrupted, run_failure};
@@ -15,7 +15,7 @@ use crate::experiment::{Finished, InstanceOptions, RunError, planner_label, run_
 /// or a table the registry refuses is bad input, with the file, line and field).
 pub(crate) fn load_source(
     source: &args::ScenarioArgs,
-    registry: &sim::BehaviourRegistry,
+    registry: &sim::registry::BehaviourRegistry,
 ) -> Result<Scenario, Failure> {
     let mut scenario = load_scenario(&source.scenario, source.params)?;
     if let Some(mode) = source.recorded_traffic {

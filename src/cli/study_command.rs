@@ -7,11 +7,13 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use crate::study::plan::StudyPlan;
 use crate::study::report::{
     self, REPORT_MD, ROWS_JSONL, StudyReport, check_out, create_out, default_out, shard_rows_file,
 };
 use crate::study::runner::{self, StudyRow, jsonl_line, read_rows};
-use crate::study::{RunOptions, StudyError, StudyPlan, analyse, provenance, run_study};
+use crate::study::runner::{RunOptions, StudyError, run_study};
+use crate::study::{analyse, provenance};
 use crate::sweep::Shard;
 use anyhow::{Context, anyhow};
 use clap::Args;

@@ -4,12 +4,13 @@
 //!
 //! - [`distributions`]: Student's t, the standard normal and the binomial (CDFs and quantiles,
 //!   on the regularised incomplete beta function);
-//! - [`paired_t`](mod@paired_t): the paired t-interval and t-test on per-instance differences (Student 1908);
+//! - `paired_t` ([`paired_t()`], [`PairedT`]): the paired t-interval and t-test on
+//!   per-instance differences (Student 1908);
 //! - `wilcoxon`: the Wilcoxon signed-rank test (Wilcoxon 1945), as `scipy.stats.wilcoxon`;
 //! - `mcnemar`: the exact McNemar test on a paired 2×2 table (McNemar 1947);
 //! - `paired_proportions`: Newcombe's (1998) method 10 interval for the difference of paired
 //!   proportions;
-//! - [`holm`](mod@holm): Holm's (1979) step-down adjustment of a family of p-values.
+//! - `holm` ([`holm()`]): Holm's (1979) step-down adjustment of a family of p-values.
 //!
 //! Percentiles and means of a sample are not here: they are `crate::sweep::statistics`
 //! (`mean`, `nearest_rank_percentile`, `wilson_interval`), which this module reuses.
@@ -18,10 +19,10 @@
 //! (`tests/inference_reference.rs`, fixture written by `scripts/inference_reference.py`).
 
 pub mod distributions;
-pub mod holm;
+pub(crate) mod holm;
 pub(crate) mod mcnemar;
 pub(crate) mod paired_proportions;
-pub mod paired_t;
+pub(crate) mod paired_t;
 pub(crate) mod wilcoxon;
 
 pub use holm::holm;

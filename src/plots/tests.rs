@@ -13,7 +13,7 @@ fn caption() -> RunCaption {
 }
 
 fn merge_lanes() -> LaneRoad {
-    planner::MergeRoad::default()
+    mergesim_types::MergeRoad::default()
         .lane_road()
         .unwrap_or_else(|e| panic!("{e}"))
 }
@@ -371,8 +371,9 @@ fn a_missing_folder_is_rejected() {
 /// vehicle driving round it in its colour.
 #[test]
 fn the_paths_figure_draws_a_curved_road() {
-    let spec = mergesim_types::lanes::curved_merge_spec(&planner::MergeRoad::default(), 300.0)
-        .unwrap_or_else(|e| panic!("{e}"));
+    let spec =
+        mergesim_types::lanes::curved_merge_spec(&mergesim_types::MergeRoad::default(), 300.0)
+            .unwrap_or_else(|e| panic!("{e}"));
     let lanes = LaneRoad::new(&spec).unwrap_or_else(|e| panic!("{e}"));
     let lane = lanes
         .lane(mergesim_types::lanes::THROUGH_LANE_ID)

@@ -21,7 +21,7 @@ const NOT_ENDPOINTS: [&str; 3] = [
 /// The per-vehicle figures an endpoint may name, sorted: every numeric field of a vehicle's
 /// summary and of its `paper_metrics` (read off a summary, so new figures join by themselves).
 pub fn vehicle_figures() -> Vec<String> {
-    let Ok(lanes) = planner::MergeRoad::default().lane_road() else {
+    let Ok(lanes) = mergesim_types::MergeRoad::default().lane_road() else {
         return Vec::new();
     };
     let template = VehicleMetrics::new("v")

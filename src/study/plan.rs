@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use scenarios::source_location::line_of;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
@@ -210,12 +210,15 @@ impl StudyPlan {
 
     /// Loads and checks the plan at `path`, its planners among the built-in ones.
     pub fn load(path: &Path) -> Result<Self, PlanError> {
-        Self::load_with(path, &sim::BehaviourRegistry::builtin())
+        Self::load_with(path, &sim::registry::BehaviourRegistry::builtin())
     }
 
     /// Loads and checks the plan at `path`, its planners among those of `registry` (a user's
     /// planners by name).
-    pub fn load_with(path: &Path, registry: &sim::BehaviourRegistry) -> Result<Self, PlanError> {
+    pub fn load_with(
+        path: &Path,
+        registry: &sim::registry::BehaviourRegistry,
+    ) -> Result<Self, PlanError> {
         let text =
             mergesim_types::files::read_regular_text(path, MAX_PLAN_BYTES).map_err(|source| {
                 PlanError::Io {
@@ -229,14 +232,14 @@ impl StudyPlan {
     /// Parses and checks `text`, the plan at `path` (relative paths start from its folder), its
     /// planners among the built-in ones.
     pub fn from_text(text: &str, path: &Path) -> Result<Self, PlanError> {
-        Self::from_text_with(text, path, &sim::BehaviourRegistry::builtin())
+        Self::from_text_with(text, path, &sim::registry::BehaviourRegistry::builtin())
     }
 
     /// [`StudyPlan::from_text`] with the planners of `registry`.
     pub fn from_text_with(
         text: &str,
         path: &Path,
-        registry: &sim::BehaviourRegistry,
+        registry: &sim::registry::BehaviourRegistry,
     ) -> Result<Self, PlanError> {
         let origin = path.display().to_string();
         let raw: RawPlan = toml::from_str(text).map_err(|e| PlanError::Parse {

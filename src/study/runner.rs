@@ -85,9 +85,9 @@ pub enum StudyError {
 /// How to run a study (does not change its results).
 #[derive(Clone, Debug)]
 pub struct RunOptions {
-    /// The planners by name ([`sim::BehaviourRegistry::builtin`] by default; the registry the
+    /// The planners by name ([`sim::registry::BehaviourRegistry::builtin`] by default; the registry the
     /// plan was checked against).
-    pub registry: Arc<sim::BehaviourRegistry>,
+    pub registry: Arc<sim::registry::BehaviourRegistry>,
     /// Worker threads (`None`: one per core).
     pub threads: Option<usize>,
     /// The part to run.
@@ -102,7 +102,7 @@ impl Default for RunOptions {
     /// The built-in planners, one thread per core, the whole study, nothing resumed.
     fn default() -> Self {
         Self {
-            registry: Arc::new(sim::BehaviourRegistry::builtin()),
+            registry: Arc::new(sim::registry::BehaviourRegistry::builtin()),
             threads: None,
             shard: None,
             interrupt: None,
@@ -132,7 +132,7 @@ pub fn run_one(
     cell: usize,
     instance: u64,
     planner: &str,
-    registry: &sim::BehaviourRegistry,
+    registry: &sim::registry::BehaviourRegistry,
     interrupt: Option<Arc<AtomicBool>>,
 ) -> Option<StudyRow> {
     let seed = instance_seed(plan.seed, instance);

@@ -214,7 +214,7 @@ where
 /// replace them.
 fn check_planner_names(
     plan: &PairedSweepPlan,
-    registry: &sim::BehaviourRegistry,
+    registry: &sim::registry::BehaviourRegistry,
 ) -> Result<(), SweepError> {
     let unknown = |name: &str, whose: &str| {
         SweepError::Invalid(format!(
@@ -231,12 +231,14 @@ fn check_planner_names(
     }
     for vehicle in &plan.scenario.vehicles {
         match &vehicle.driver {
-            sim::Driver::Planner { name, .. }
+            sim::config::Driver::Planner { name, .. }
                 if plan.planners.is_empty() && !registry.contains(name) =>
             {
                 return Err(unknown(name, &format!("vehicle {}", vehicle.name)));
             }
-            sim::Driver::Prescribed { path_planner, .. } if !registry.contains(path_planner) => {
+            sim::config::Driver::Prescribed { path_planner, .. }
+                if !registry.contains(path_planner) =>
+            {
                 return Err(unknown(path_planner, &format!("vehicle {}", vehicle.name)));
             }
             _ => {}

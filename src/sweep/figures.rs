@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use serde::{Deserialize, Serialize};
 
 use super::RunMetrics;

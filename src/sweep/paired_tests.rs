@@ -411,10 +411,10 @@ fn an_unregistered_planner_is_refused_before_any_run_and_a_registered_one_runs()
         "{err}"
     );
     // The same name, registered, runs (the registry travels in the options).
-    let mut registry = sim::BehaviourRegistry::builtin();
-    let pf_cs_again: sim::BehaviourFactory =
-        std::sync::Arc::new(|input: &sim::FactoryInput<'_>| {
-            sim::BehaviourRegistry::builtin().create("pf-cs", input)
+    let mut registry = sim::registry::BehaviourRegistry::builtin();
+    let pf_cs_again: sim::registry::BehaviourFactory =
+        std::sync::Arc::new(|input: &sim::registry::FactoryInput<'_>| {
+            sim::registry::BehaviourRegistry::builtin().create("pf-cs", input)
         });
     registry.register("mine", pf_cs_again).unwrap();
     let options = SweepOptions {

@@ -7,7 +7,7 @@ use std::process::{Command, Output};
 
 use mergesim::experiment::{InstanceOptions, run_quietly};
 use mergesim::planner::PlannerKind;
-use mergesim::scenarios::Scenario;
+use mergesim::scenarios::scenario::Scenario;
 use mergesim::sim::RunOutcome;
 
 /// Runs `scenario` in the closed loop without recording (`planner` overrides every

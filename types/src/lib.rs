@@ -15,10 +15,13 @@
 //! - The interface every driver implements: [`Behaviour`], fed an [`Observation`], answering a
 //!   [`Decision`] (with [`DegradedMode`], [`OptimiserReport`], [`BehaviourError`]).
 //! - A sampling grid [`GridSpec`] (at most [`MAX_GRID_CELLS`] cells), a parameter's range
-//!   [`Bound`] ([`bounds`]) and the error for a value out of range, [`InvalidParameter`].
+//!   [`bounds::Bound`] ([`bounds`]) and the error for a value out of range, [`InvalidParameter`].
 //! - Helpers: [`angle::wrap_angle_rad`] (the one angle wrap), [`files::read_regular_text`],
-//!   [`percentile::nearest_rank_percentile`] and the
-//!   merge road's limits in [`road`].
+//!   [`percentile::nearest_rank_percentile`] and the merge road's limits [`ROAD_BOUNDS`] and
+//!   [`MERGE_SECTION_LENGTH_M`].
+//!
+//! Each item has one path: the crate root's, or that of the public module holding it
+//! (`mergesim_types::bounds::Bound`, `mergesim_types::lanes::LaneRoad`).
 #![warn(missing_docs)]
 
 pub mod angle;
@@ -30,15 +33,14 @@ pub(crate) mod grid;
 pub mod lanes;
 pub(crate) mod path;
 pub mod percentile;
-pub mod road;
+pub(crate) mod road;
 pub(crate) mod vehicle;
 
 pub use behaviour::{
     Behaviour, BehaviourError, Decision, DegradedMode, FallbackReason, Observation, OptimiserReport,
 };
-pub use bounds::Bound;
 pub use error::InvalidParameter;
 pub use grid::{GridSpec, MAX_GRID_CELLS};
 pub use path::{PathPoint, SharedLocalPath, TimedWaypoint};
-pub use road::{Lane, MergeRoad};
+pub use road::{Lane, MERGE_SECTION_LENGTH_M, MergeRoad, ROAD_BOUNDS};
 pub use vehicle::{Neighbour, VehicleId, VehicleShape, VehicleState};

@@ -14,7 +14,8 @@ use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use mergesim_types::{Lane, MergeRoad, PathPoint};
-use vehicles::{PhysicsWorld, Tracker, TrackerParams, Vehicle, VehicleParams};
+use vehicles::tracker::{Tracker, TrackerParams};
+use vehicles::{PhysicsWorld, Vehicle, VehicleParams};
 
 const DT_S: f64 = 0.002;
 const VEHICLES: usize = 10;

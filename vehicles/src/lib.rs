@@ -15,17 +15,22 @@
 //!
 //! # Public API
 //! - The physics scene: [`PhysicsWorld`] (gravity [`GRAVITY_MPS2`]) with the road's walls,
-//!   [`RoadColliders`] from [`RoadColliderParams`] ([`road_collider`], [`collision_groups`]).
+//!   [`road_collider::RoadColliders`] from [`road_collider::RoadColliderParams`]
+//!   ([`road_collider`], [`collision_groups`]).
 //! - A car: [`Vehicle`] from [`VehicleParams`] and [`TireParams`] (the presets
 //!   [`PRESET_NAMES`]), driven by [`Controls`] ([`WHEEL_NAMES`]), read back as [`Kinematics`],
 //!   [`BodyBox`] and [`WheelTelemetry`]; a body moved kinematically, [`KinematicBox`].
-//! - The path tracker: [`Tracker`] from [`TrackerParams`], with its [`SpeedController`].
-//! - Validation: [`run_maneuver`] of a [`ManeuverConfig`] ([`ManeuverKind`]) gives a
-//!   [`ManeuverReport`], compared with the linear single-track model [`LinearSingleTrack`]
-//!   ([`linear_yaw_rate_radps`]).
+//! - The path tracker: [`tracker::Tracker`] from [`tracker::TrackerParams`], with its
+//!   [`tracker::SpeedController`].
+//! - Validation: [`maneuver::run_maneuver`] of a [`maneuver::ManeuverConfig`]
+//!   ([`maneuver::ManeuverKind`]) gives a [`maneuver::ManeuverReport`], compared with the linear
+//!   single-track model [`LinearSingleTrack`] ([`linear_yaw_rate_radps`]).
 //! - Errors: [`VehicleError`].
 //! - CommonRoad's vehicle models ks, st and std as pure functions (no rapier), with their
 //!   parameter sets and an RK4 step: [`commonroad_models`].
+//!
+//! Each item has one path: a public module holding more than what the crate root names is
+//! the path of its items (`vehicles::tracker::Tracker`).
 #![warn(missing_docs)]
 
 pub mod collision_groups;
@@ -49,12 +54,9 @@ pub use controls::{Controls, WHEEL_NAMES};
 pub use error::VehicleError;
 pub use kinematic_body::KinematicBox;
 pub use kinematics::Kinematics;
-pub use maneuver::{ManeuverConfig, ManeuverKind, ManeuverReport, run_maneuver};
 pub use params::{TireParams, VehicleParams};
 pub use physics_world::{GRAVITY_MPS2, PhysicsWorld};
 pub use presets::PRESET_NAMES;
-pub use road_collider::{RoadColliderParams, RoadColliders};
 pub use single_track::{LinearSingleTrack, linear_yaw_rate_radps};
-pub use tracker::{SpeedController, Tracker, TrackerParams};
 pub use vehicle::{BodyBox, Vehicle};
 pub use wheel::WheelTelemetry;

@@ -15,7 +15,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::controls::Controls;
-use mergesim_types::{Bound, bounds};
+use mergesim_types::bounds::{self, Bound};
 
 use crate::error::VehicleError;
 use crate::kinematics::Kinematics;

@@ -1,10 +1,9 @@
 //! Bad input gives errors naming the value, never a panic.
 
 use mergesim_types::PathPoint;
-use vehicles::{
-    Controls, Kinematics, ManeuverConfig, ManeuverKind, PhysicsWorld, Tracker, TrackerParams,
-    Vehicle, VehicleParams, run_maneuver,
-};
+use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
+use vehicles::tracker::{Tracker, TrackerParams};
+use vehicles::{Controls, Kinematics, PhysicsWorld, Vehicle, VehicleParams};
 
 #[test]
 fn unknown_preset_lists_valid_names() {

@@ -1,10 +1,8 @@
 //! Straight-line braking against the friction-limited distance v²/(2μg) and, with locked
 //! wheels, against the Magic Formula's sliding friction.
 
-use vehicles::{
-    GRAVITY_MPS2, ManeuverConfig, ManeuverKind, PRESET_NAMES, TireParams, VehicleParams,
-    run_maneuver,
-};
+use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
+use vehicles::{GRAVITY_MPS2, PRESET_NAMES, TireParams, VehicleParams};
 
 fn braking(vehicle_params: VehicleParams, name: &str, speed_mps: f64, mu: f64) -> (f64, f64) {
     let cfg = ManeuverConfig {

@@ -1,10 +1,9 @@
 //! Bitwise determinism: identical runs give identical trajectories.
 
 use mergesim_types::{Lane, MergeRoad, PathPoint};
-use vehicles::{
-    ManeuverConfig, ManeuverKind, PhysicsWorld, Tracker, TrackerParams, Vehicle, VehicleParams,
-    run_maneuver,
-};
+use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
+use vehicles::tracker::{Tracker, TrackerParams};
+use vehicles::{PhysicsWorld, Vehicle, VehicleParams};
 
 /// Three cars on the merge road, two of them converging on the same lane, tracked for 4 s.
 fn run_merge_road() -> Vec<u64> {

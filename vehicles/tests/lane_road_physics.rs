@@ -3,10 +3,9 @@
 
 use mergesim_types::lanes::{LaneRoad, LaneRoadSpec, THROUGH_LANE_ID, curved_merge_spec};
 use mergesim_types::{MergeRoad, PathPoint};
-use vehicles::{
-    Controls, Kinematics, PhysicsWorld, RoadColliders, Tracker, TrackerParams, Vehicle,
-    VehicleParams,
-};
+use vehicles::road_collider::RoadColliders;
+use vehicles::tracker::{Tracker, TrackerParams};
+use vehicles::{Controls, Kinematics, PhysicsWorld, Vehicle, VehicleParams};
 
 const DT_S: f64 = 0.002;
 const RADIUS_M: f64 = 300.0;

@@ -1,10 +1,8 @@
 //! Steady-state cornering against the linear single-track model (closed forms in
 //! `vehicles::single_track`) and against the quasi-static roll equation.
 
-use vehicles::{
-    GRAVITY_MPS2, LinearSingleTrack, ManeuverConfig, ManeuverKind, ManeuverReport, PRESET_NAMES,
-    VehicleParams, run_maneuver,
-};
+use vehicles::maneuver::{ManeuverConfig, ManeuverKind, ManeuverReport, run_maneuver};
+use vehicles::{GRAVITY_MPS2, LinearSingleTrack, PRESET_NAMES, VehicleParams};
 
 fn steady_state(vehicle: &str, speed_mps: f64, steer_rad: f64) -> ManeuverReport {
     let cfg = ManeuverConfig {

@@ -1,7 +1,8 @@
 //! The tracker follows a straight road with a lane change and holds a speed profile.
 
 use mergesim_types::PathPoint;
-use vehicles::{PhysicsWorld, Tracker, TrackerParams, Vehicle, VehicleParams};
+use vehicles::tracker::{Tracker, TrackerParams};
+use vehicles::{PhysicsWorld, Vehicle, VehicleParams};
 
 const LANE_WIDTH_M: f64 = 3.5;
 const CHANGE_START_M: f64 = 100.0;

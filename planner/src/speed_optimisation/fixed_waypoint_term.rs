@@ -20,7 +20,7 @@
 use super::SpeedTerm;
 use crate::obstacle_field::{MinDistanceLength, ObstacleField, ObstacleFieldParams, Role, Side};
 use crate::obstacle_field::{SelfView, min_distances};
-use crate::types::VehicleShape;
+use mergesim_types::VehicleShape;
 
 /// One other vehicle at one slot: its field centred on its shared waypoint, and what D_min needs.
 #[derive(Clone, Debug)]

@@ -130,7 +130,7 @@ mod tests {
     use super::*;
     use crate::obstacle_field::SelfView;
     use crate::params::PlannerParams;
-    use crate::types::VehicleShape;
+    use mergesim_types::VehicleShape;
 
     #[test]
     fn interaction_gradient_matches_central_differences() {

@@ -3,9 +3,9 @@
 //!
 //! Files: `scp` (the SCP loop and its line search), `cone_program` (the convex
 //! subproblem: decision vector, constraint rows and their assembly), `newton_qp` (the same
-//! subproblem with the travel time's second-order model: a QP, `speed_program = "newton-qp"`), [`interaction_term`]
-//! (U_SLP at the planned arc length, and PF-SP's risk term), [`fixed_waypoint_term`] (U_SLP as
-//! the paper prints it), `friction_limits` (Eq. 10a).
+//! subproblem with the travel time's second-order model: a QP, `speed_program = "newton-qp"`), `interaction_term`
+//! ([`InteractionTerm`]: U_SLP at the planned arc length, and PF-SP's risk term),
+//! `fixed_waypoint_term` ([`FixedWaypointTerm`]: U_SLP as the paper prints it), `friction_limits` (Eq. 10a).
 //!
 //! # The problem (Eq. 10, as read here)
 //!
@@ -72,9 +72,9 @@
 //! w_R·Σ U_i of PF-SP's risk-aware speeds, with its own weight in `SpeedProblem`.
 
 pub(crate) mod cone_program;
-pub mod fixed_waypoint_term;
+pub(crate) mod fixed_waypoint_term;
 pub(crate) mod friction_limits;
-pub mod interaction_term;
+pub(crate) mod interaction_term;
 pub(crate) mod newton_qp;
 pub(crate) mod scp;
 

@@ -4,9 +4,11 @@
 use super::*;
 use crate::parameter_set::ParameterSet;
 use crate::params::PlannerParams;
-use crate::planners::{PfPlanner, PlannerKind};
-use crate::road::{Lane, MergeRoad};
-use crate::types::{Neighbour, SharedLocalPath, TimedWaypoint, VehicleShape, VehicleState};
+use crate::planner_kind::PlannerKind;
+use crate::planners::PfPlanner;
+use mergesim_types::{
+    Lane, MergeRoad, Neighbour, SharedLocalPath, TimedWaypoint, VehicleShape, VehicleState,
+};
 
 /// The merge road with its merge section ending at x = 50 m: one lane (the upper) beyond, so
 /// nobody can pass the stopped car.
@@ -50,7 +52,7 @@ fn plan_once(
     ego: VehicleState,
     neighbours: &[Neighbour],
     shared: &[SharedLocalPath],
-) -> crate::types::Plan {
+) -> crate::Plan {
     planner
         .plan(&PlanRequest {
             time_s,
@@ -73,7 +75,7 @@ fn leader(state: VehicleState) -> Neighbour {
     }
 }
 
-fn assert_finite_and_non_negative(plan: &crate::types::Plan, what: &str) {
+fn assert_finite_and_non_negative(plan: &crate::Plan, what: &str) {
     for p in &plan.path {
         assert!(
             p.x_m.is_finite() && p.y_m.is_finite() && p.t_s.is_finite(),

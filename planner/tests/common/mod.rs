@@ -2,10 +2,9 @@
 //! exactly along their own timed plans (`Plan::kinematic_state_at`), no tracker, no tyres.
 #![allow(dead_code)]
 
-use planner::{
-    MergeRoad, Neighbour, PfPlanner, PlanRequest, PlannerKind, PlannerParams, SharedLocalPath,
-    VehicleShape, VehicleState,
-};
+use mergesim_types::{MergeRoad, Neighbour, SharedLocalPath, VehicleShape, VehicleState};
+use planner::params::PlannerParams;
+use planner::{PfPlanner, PlanRequest, PlannerKind};
 
 /// A road whose merge section ends at x = 50 m: from there on one lane (the upper one), so a
 /// follower cannot overtake.
@@ -33,7 +32,7 @@ pub fn following(
     let road = single_lane_road();
     let shape = VehicleShape::default();
     let mut planner = PfPlanner::new(kind, params.clone(), road.lane_road().unwrap()).unwrap();
-    let y_m = road.lane_center_y_m(planner::Lane::Upper);
+    let y_m = road.lane_center_y_m(mergesim_types::Lane::Upper);
     let mut follower = VehicleState {
         x_m: 100.0,
         y_m,
@@ -63,7 +62,7 @@ pub fn following(
                 .map(|i| {
                     let dt = i as f64 * params.step_time_s;
                     let s = leader_at(t_s + dt);
-                    planner::TimedWaypoint {
+                    mergesim_types::TimedWaypoint {
                         t_s: t_s + dt,
                         x_m: s.x_m,
                         y_m: s.y_m,
@@ -137,7 +136,7 @@ pub fn equal_speed_min_distance_m(v_mps: f64, time_gap_s: f64) -> f64 {
 pub fn lateral_equilibrium_m(params: &PlannerParams, neighbour: Option<(f64, f64)>) -> f64 {
     let road = MergeRoad::default();
     let shape = VehicleShape::default();
-    let centre = road.lane_center_y_m(planner::Lane::Upper);
+    let centre = road.lane_center_y_m(mergesim_types::Lane::Upper);
     let ego = VehicleState {
         x_m: 100.0,
         y_m: centre,
@@ -158,7 +157,7 @@ pub fn lateral_equilibrium_m(params: &PlannerParams, neighbour: Option<(f64, f64
         .into_iter()
         .collect();
     let geometry = planner::lane_road_field::LaneRoadGeometry::new(&road.lane_road().unwrap());
-    let field = planner::PotentialField::new(
+    let field = planner::potential_field::PotentialField::new(
         &planner::potential_field::UniversalFieldParams::from(params),
         &geometry,
         0,
@@ -189,7 +188,7 @@ pub fn first_planned_speed_mps(
     let mut planner = PfPlanner::new(kind, params.clone(), road.lane_road().unwrap()).unwrap();
     let ego = VehicleState {
         x_m: 20.0,
-        y_m: road.lane_center_y_m(planner::Lane::Lower),
+        y_m: road.lane_center_y_m(mergesim_types::Lane::Lower),
         yaw_rad: 0.0,
         speed_mps: 20.0,
     };
@@ -198,7 +197,7 @@ pub fn first_planned_speed_mps(
             id: 1,
             state: VehicleState {
                 x_m: 20.0 + ahead,
-                y_m: road.lane_center_y_m(planner::Lane::Upper),
+                y_m: road.lane_center_y_m(mergesim_types::Lane::Upper),
                 yaw_rad: 0.0,
                 speed_mps: 20.0,
             },

@@ -163,7 +163,7 @@ impl Scenario {
             }
             boxes.push((v.name.clone(), swept));
             let prescribed_max_mps = match &v.driver {
-                sim::Driver::Prescribed { speed_profile, .. } => speed_profile
+                sim::config::Driver::Prescribed { speed_profile, .. } => speed_profile
                     .points
                     .iter()
                     .map(|p| p[1])

@@ -5,14 +5,15 @@
 //! `planner::params_tables`) are views on the one `PlannerParams`: the loader merges them into
 //! the scenario's `planner_overrides`, applied on top of the `--params` set. Any other name's
 //! table stays in `sim.planners` for that planner's schema. A vehicle's `params` overlay its
-//! planner's table for that vehicle alone (`sim::Driver::Planner::params`).
+//! planner's table for that vehicle alone (`sim::config::Driver::Planner::params`).
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use planner::params_tables::{self, PF_TABLE, PF_TABLES};
+use sim::ParamsError;
+use sim::config::Driver;
 use sim::registry::BehaviourRegistry;
-use sim::{Driver, ParamsError};
 
 use super::{Line, Scenario, ScenarioError, ScenarioSource};
 use crate::source_location::line_of;

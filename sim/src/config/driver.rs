@@ -11,7 +11,7 @@
 
 use std::fmt;
 
-use planner::SpeedProfile;
+use planner::speed_profile::SpeedProfile;
 use serde::de::{self, MapAccess, Visitor};
 use serde::ser::SerializeMap;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};

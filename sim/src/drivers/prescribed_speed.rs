@@ -3,7 +3,7 @@
 //! speed optimiser.
 
 use mergesim_types::{Behaviour, BehaviourError, Decision, GridSpec, Observation, SharedLocalPath};
-use planner::SpeedProfile;
+use planner::speed_profile::SpeedProfile;
 use planner::speed_profile::retime_path;
 
 /// A planner's path at prescribed speeds (module doc).

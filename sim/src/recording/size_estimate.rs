@@ -35,7 +35,12 @@ pub fn estimated_bytes(
     let detailed = &specs[..detail];
     let planners = detailed
         .iter()
-        .filter(|s| !matches!(s.driver, crate::Driver::Idm | crate::Driver::LaneKeeping))
+        .filter(|s| {
+            !matches!(
+                s.driver,
+                crate::config::Driver::Idm | crate::config::Driver::LaneKeeping
+            )
+        })
         .count() as f64;
     let listeners = detailed.iter().filter(|s| s.connected).count() as f64;
     BYTES_PER_VEHICLE_INSTANT * vehicles * instants

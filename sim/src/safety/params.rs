@@ -1,6 +1,7 @@
 //! Thresholds of the safety metrics, and the errors of the safety checks.
 
-use mergesim_types::{Bound, InvalidParameter, VehicleId, bounds};
+use mergesim_types::bounds::Bound;
+use mergesim_types::{InvalidParameter, VehicleId, bounds};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 

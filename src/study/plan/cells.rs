@@ -6,7 +6,7 @@
 
 use std::collections::BTreeMap;
 
-use scenarios::Scenario;
+use scenarios::scenario::Scenario;
 use scenarios::source_location::line_of;
 
 use super::{Cell, PlanError, RawPlan};

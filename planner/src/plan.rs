@@ -1,12 +1,7 @@
-//! The planner's output (a plan, and why it may be a fallback), and the plain shared types it
-//! re-exports from `mergesim-types`.
+//! The planner's output: a plan (and, when it is a fallback, why).
 
+use mergesim_types::{FallbackReason, PathPoint, SharedLocalPath, VehicleState};
 use serde::{Deserialize, Serialize};
-
-pub use mergesim_types::{
-    FallbackReason, Neighbour, PathPoint, SharedLocalPath, TimedWaypoint, VehicleId, VehicleShape,
-    VehicleState,
-};
 
 /// The output of one planning cycle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -61,6 +56,7 @@ impl Plan {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mergesim_types::VehicleShape;
 
     fn plan_through(points: &[(f64, f64, f64, f64)]) -> Plan {
         Plan {
