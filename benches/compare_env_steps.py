@@ -9,15 +9,17 @@ script was written and run against.
 
 What one step is, on each side (not the same model: a throughput comparison, not a
 like-for-like one):
-  * MergeEnv("urgent_merge"): one planning period, 0.1 s simulated: 50 Rapier steps of the
-    two vehicles (tyre forces, tracking), the other vehicle's PF-ISO plan, V2V, safety and the
-    observation and reward. The policy holds 20 m/s on the lane it is in (action [20, 0]).
+  * MergeEnv("urgent_merge"): one planning period, 0.1 s simulated: 50 physics steps of the
+    two vehicles (tracking; tyre forces and a Rapier step with the default `rapier` vehicles,
+    an RK4 step of CommonRoad's kinematic single track with `ks` vehicles, passed as
+    params={"sim": {"vehicle_model": "ks"}}), the other vehicle's PF-ISO plan, V2V, safety and
+    the observation and reward. The policy holds 20 m/s on the lane it is in (action [20, 0]).
   * highway-env merge-v0 (default config): one policy step, 1 s simulated: 15 kinematic steps
     of its 5 vehicles (IDM + MOBIL), the Kinematics observation and the reward; the policy is
     the IDLE action.
 Both columns are given: steps per wall second and simulated seconds per wall second. Each
 repetition times --steps steps of each environment (resetting on termination, the reset
-included), interleaved (highway-env, mergesim, highway-env, ...), after one untimed warm-up
+included), interleaved (highway-env, mergesim rapier, mergesim ks, ...), after one untimed warm-up
 step of each. Python start-up, imports and construction are excluded on both sides.
 """
 import argparse
@@ -27,10 +29,10 @@ import sys
 import time
 
 
-def time_mergesim(steps, seed):
+def time_mergesim(steps, seed, vehicle_model="rapier"):
     import mergesim
 
-    env = mergesim.MergeEnv("urgent_merge")
+    env = mergesim.MergeEnv("urgent_merge", params={"sim": {"vehicle_model": vehicle_model}})
     env.reset(seed=seed)
     env.step([20.0, 0.0])
     started = time.perf_counter()
@@ -65,12 +67,13 @@ def main():
     args = ap.parse_args()
     if args.steps < 1 or args.reps < 1:
         sys.exit("--steps and --reps must be at least 1")
-    samples = {"mergesim": [], "highway-env": []}
+    samples = {"highway-env": [], "mergesim (rapier)": [], "mergesim (ks)": []}
     for rep in range(args.reps):
         samples["highway-env"].append(time_highway_env(args.steps, rep))
-        samples["mergesim"].append(time_mergesim(args.steps, rep))
+        samples["mergesim (rapier)"].append(time_mergesim(args.steps, rep, "rapier"))
+        samples["mergesim (ks)"].append(time_mergesim(args.steps, rep, "ks"))
         print(f"repetition {rep + 1}/{args.reps}", file=sys.stderr)
-    simulated_s_per_step = {"mergesim": 0.1, "highway-env": 1.0}
+    simulated_s_per_step = {"highway-env": 1.0, "mergesim (rapier)": 0.1, "mergesim (ks)": 0.1}
     print("| environment | steps/s (median, min–max) | simulated s per wall s (median) |")
     print("|---|---|---|")
     for name, walls in samples.items():

@@ -44,6 +44,8 @@ def parse_args() -> argparse.Namespace:
     p.add_argument("--reps", type=int, default=5)
     p.add_argument("--scenario", default="urgent_merge")
     p.add_argument("--planner", default=None)
+    p.add_argument("--vehicle-model", default=None,
+                   help="vehicle model of every mergesim car (merge_sim run --vehicle-model)")
     p.add_argument("--hwe-episodes", type=int, default=10)
     p.add_argument("--hwe-seed", type=int, default=0)
     p.add_argument("--hwe-max-policy-steps", type=int, default=1000,
@@ -216,7 +218,13 @@ class MergeSim:
         self.cmd = [self.bin, "run", "--scenario", self.scenario, "--no-rrd", "--json", self.out, "--quiet"]
         if planner:
             self.cmd += ["--planner", planner]
-        self.label = f"mergesim {self.scenario} ({planner or 'scenario default'})"
+        self.vehicle_model = args.vehicle_model
+        if self.vehicle_model:
+            self.cmd += ["--vehicle-model", self.vehicle_model]
+        self.label = f"mergesim {self.scenario} ({planner or 'scenario default'}{self._model()})"
+
+    def _model(self) -> str:
+        return f", {self.vehicle_model} vehicles" if self.vehicle_model else ""
 
     def run(self) -> dict:
         if os.path.exists(self.out):
@@ -234,7 +242,7 @@ class MergeSim:
         n = len(d["vehicles"])
         planner = d.get("planner")
         if planner:
-            self.label = f"mergesim {self.scenario} ({planner})"
+            self.label = f"mergesim {self.scenario} ({planner}{self._model()})"
         per_vehicle = sum(float(v.get("duration_s", d["duration_s"])) for v in d["vehicles"])
         return {
             "wall_s": wall,  # process wall time, start-up included
@@ -378,6 +386,7 @@ def main() -> int:
             "reps": args.reps,
             "scenario": args.scenario,
             "planner": args.planner,
+            "vehicle_model": args.vehicle_model,
             "variants": {key: {"label": v.label, "command": getattr(v, "cmd", None),
                                "summary": summ[key], "samples": samples[key]} for key, v in variants},
             "ratios_to_highway_env": {key: {"process": summ[key]["rate_median"] / base,

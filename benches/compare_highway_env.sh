@@ -40,7 +40,7 @@
 # merge_sim binary is built (`cargo build --release --bin merge_sim`) if missing, or always with
 # --build. Needs bash, python3 (with venv/ensurepip), pip access to PyPI, cargo.
 #
-# Usage: benches/compare_highway_env.sh [--reps N] [--scenario NAME] [--planner NAME]
+# Usage: benches/compare_highway_env.sh [--reps N] [--scenario NAME] [--planner NAME] [--vehicle-model M]
 #                                       [--hwe-episodes N] [--json PATH] [--build] [--help]
 set -euo pipefail
 
@@ -60,6 +60,8 @@ Options:
   --scenario NAME    mergesim scenario, built-in name or TOML path (default urgent_merge)
   --planner NAME     planner for the main mergesim row (passed to `merge_sim run --planner`;
                      default: the scenario's own, PF-ISO for urgent_merge)
+  --vehicle-model M  vehicle model of every mergesim car (`merge_sim run --vehicle-model`:
+                     rapier, the default, ks, st or std)
   --hwe-episodes N   highway-env episodes per repetition (default 10)
   --json PATH        also write all samples and the environment as JSON
   --build            run `cargo build --release --bin merge_sim` even if the binary exists
@@ -73,6 +75,7 @@ EOF
 reps=5
 scenario=urgent_merge
 planner=""
+vehicle_model=""
 hwe_episodes=10
 json=""
 build=0
@@ -82,6 +85,7 @@ while [[ $# -gt 0 ]]; do
     --reps) need "$@"; reps=$2; shift 2 ;;
     --scenario) need "$@"; scenario=$2; shift 2 ;;
     --planner) need "$@"; planner=$2; shift 2 ;;
+    --vehicle-model) need "$@"; vehicle_model=$2; shift 2 ;;
     --hwe-episodes) need "$@"; hwe_episodes=$2; shift 2 ;;
     --json) need "$@"; json=$2; shift 2 ;;
     --build) build=1; shift ;;
@@ -119,5 +123,6 @@ fi
 
 args=(--bin "$bin" --root "$root" --reps "$reps" --scenario "$scenario" --hwe-episodes "$hwe_episodes")
 if [[ -n $planner ]]; then args+=(--planner "$planner"); fi
+if [[ -n $vehicle_model ]]; then args+=(--vehicle-model "$vehicle_model"); fi
 if [[ -n $json ]]; then args+=(--json "$json"); fi
 exec "$py" "$root/benches/compare_highway_env.py" "${args[@]}"

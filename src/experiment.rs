@@ -125,7 +125,8 @@ pub fn run_instance(
         wall_time_s,
         &outcome,
     )
-    .with_recorded_traffic(&scenario.sim);
+    .with_recorded_traffic(&scenario.sim)
+    .with_vehicle_model(&scenario.sim, &scenario.vehicles);
     Ok(Finished { summary, outcome })
 }
 

@@ -30,6 +30,10 @@ pub struct RunSummary {
     /// ([`RunSummary::with_recorded_traffic`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub recorded_traffic: Option<String>,
+    /// What moved the cars (`ks`, `st`, `std`, a user's model, or `mixed`); absent when every
+    /// car is the default `rapier` one. Filled by the caller ([`RunSummary::with_vehicle_model`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vehicle_model: Option<String>,
     /// Number of collision events (vehicle–vehicle and vehicle–road edge) of the simulated
     /// vehicles, without those caused by the replay of recorded traffic.
     pub collisions: usize,
@@ -89,6 +93,7 @@ impl RunSummary {
             seed,
             drawn: None,
             recorded_traffic: None,
+            vehicle_model: None,
             duration_s: outcome.duration_s,
             wall_time_s,
             collisions: outcome.safety.own_collisions() + outcome.safety.edge_contacts.len(),
@@ -126,6 +131,27 @@ impl RunSummary {
         self
     }
 
+    /// The summary with `vehicle_model` named from the vehicles of `sim` and `vehicles`: their
+    /// one model, or `mixed`; nothing when every car is `rapier`.
+    pub fn with_vehicle_model(
+        mut self,
+        sim: &sim::config::SimConfig,
+        vehicles: &[sim::config::VehicleSpec],
+    ) -> Self {
+        let mut names: Vec<&str> = vehicles
+            .iter()
+            .map(|v| sim::vehicle_models::model_of(sim, v).0)
+            .collect();
+        names.sort_unstable();
+        names.dedup();
+        self.vehicle_model = match names.as_slice() {
+            [] | [sim::vehicle_models::DEFAULT_VEHICLE_MODEL] => None,
+            [one] => Some((*one).to_string()),
+            _ => Some("mixed".to_string()),
+        };
+        self
+    }
+
     /// A fixed-width table for the terminal.
     pub fn table(&self) -> String {
         let mut out = String::new();
@@ -133,8 +159,13 @@ impl RunSummary {
             .min_ttc_s
             .map(|t| format!("{t:.2} s"))
             .unwrap_or_else(|| "never closing".into());
+        let vehicles = self
+            .vehicle_model
+            .as_ref()
+            .map(|m| format!("  vehicles {m}"))
+            .unwrap_or_default();
         out.push_str(&format!(
-            "scenario {}  planner {} ({} parameters)  simulated {:.1} s in {:.2} s wall\n",
+            "scenario {}  planner {} ({} parameters){vehicles}  simulated {:.1} s in {:.2} s wall\n",
             self.scenario, self.planner, self.params, self.duration_s, self.wall_time_s
         ));
         out.push_str(&format!(
@@ -248,6 +279,7 @@ mod tests {
         let ego = VehicleSpec {
             name: "ego".into(),
             preset: "bmw_320i".into(),
+            vehicle_model: None,
             lane: Lane::Upper.into(),
             x_m: 100.0,
             y_offset_m: 0.0,

@@ -153,6 +153,11 @@ impl EnvCore {
             ))
             .into());
         }
+        // Its vehicle models (`params={"sim": {"vehicle_model": "ks"}}`), refused here rather
+        // than at the first reset.
+        scenario
+            .check_vehicle_models(&registry)
+            .map_err(|e| BindingError::input(&e))?;
         let command: SharedCommand = Arc::new(Mutex::new(Command {
             target_speed_mps: scenario.vehicles[agent].target_speed_mps,
             target_y_m: 0.0,

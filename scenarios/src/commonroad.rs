@@ -344,6 +344,7 @@ pub fn ego_of(
     Ok(VehicleSpec {
         name: "ego".into(),
         preset: EGO_PRESET.into(),
+        vehicle_model: None,
         lane: StartLane::Id(lane),
         x_m: s_m,
         y_offset_m: d_m,

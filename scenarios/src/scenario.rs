@@ -646,3 +646,4 @@ mod lane_road_checks;
 mod planner_tables;
 #[cfg(test)]
 mod tests;
+mod vehicle_model_choice;

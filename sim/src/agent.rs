@@ -1,11 +1,11 @@
-//! A vehicle of the world with its decision making: the Rapier vehicle, its tracker, its
+//! A vehicle of the world with its decision making: the car (moved by its vehicle model), its tracker, its
 //! behaviour (planner, human-driver model, prescribed-speed driver or a user's), the path it
 //! is tracking, and the lane it is in (lane changes are events).
 
 use mergesim_types::lanes::{LaneId, LaneRoad};
 use mergesim_types::{Behaviour, PathPoint, VehicleId, VehicleShape};
 use vehicles::tracker::Tracker;
-use vehicles::{Vehicle, VehicleParams};
+use vehicles::{VehicleModel, VehicleParams};
 
 use crate::config::{Driver, SimConfig, VehicleSpec};
 use crate::drivers::{IdmDriver, LaneKeeping, PrescribedSpeed};
@@ -21,8 +21,8 @@ pub struct Agent {
     pub spec: VehicleSpec,
     /// Footprint and braking.
     pub shape: VehicleShape,
-    /// The Rapier vehicle.
-    pub vehicle: Vehicle,
+    /// The car, moved by its vehicle model (`crate::vehicle_models`).
+    pub vehicle: Box<dyn VehicleModel>,
     /// Its decision making.
     pub behaviour: Box<dyn Behaviour>,
     /// Pure pursuit + PID.
@@ -155,7 +155,25 @@ impl Agent {
                 (x, y, lane.heading_rad(spec.x_m))
             }
         };
-        let vehicle = Vehicle::spawn(physics, &params, x_m, y_m, yaw_rad, spec.speed_mps)?;
+        let (model, field) = crate::vehicle_models::model_of(config, spec);
+        let models = registry.vehicle_models();
+        if !models.contains(model) {
+            return Err(SimError::InvalidField {
+                field,
+                message: models.unknown(model),
+            });
+        }
+        let vehicle = models.spawn(
+            model,
+            &mut crate::vehicle_models::VehicleModelInput {
+                physics,
+                params: &params,
+                pose_m: [x_m, y_m, yaw_rad],
+                speed_mps: spec.speed_mps,
+                config,
+                spec,
+            },
+        )?;
         let shape = vehicle.shape(VehicleShape::default().max_brake_decel_mps2);
         let behaviour = behaviour_of(config, spec, registry, planner_override, lanes)?;
         let tracker = Tracker::new(config.tracker.clone(), &params);

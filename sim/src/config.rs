@@ -35,6 +35,11 @@ pub struct SimConfig {
     pub lane_road: Option<LaneRoadConfig>,
     /// Tire–road friction coefficient μ.
     pub mu: f64,
+    /// What moves every car without its own `vehicle_model` (`crate::vehicle_models`):
+    /// `rapier` (the default: rigid body on ray-cast wheels), `ks`, `st` or `std` (CommonRoad's
+    /// models), or a registered model of one's own.
+    #[serde(skip_serializing_if = "is_default_vehicle_model")]
+    pub vehicle_model: String,
     /// Physics step (s): read once to build the physics world, which owns the step during a run
     /// (`vehicles::PhysicsWorld::dt_s`; the world's time and periods are counted in its steps).
     pub dt_s: f64,
@@ -82,6 +87,7 @@ impl Default for SimConfig {
             road: MergeRoad::default(),
             lane_road: None,
             mu: 0.8,
+            vehicle_model: crate::vehicle_models::DEFAULT_VEHICLE_MODEL.to_string(),
             dt_s: 0.002,
             duration_s: 25.0,
             planner_period_s: 0.1,
@@ -234,6 +240,10 @@ pub struct VehicleSpec {
     pub name: String,
     /// Vehicle preset (`bmw_320i`, `ford_escort`, `vw_vanagon`).
     pub preset: String,
+    /// What moves this car (`crate::vehicle_models`: `rapier`, `ks`, `st`, `std`, or a
+    /// registered model of one's own); `None`: the scenario's `sim.vehicle_model`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vehicle_model: Option<String>,
     /// Starting lane: `"lower"` / `"upper"` (the merge road's lanes 2 and 1) or a lane id
     /// (`lanelet = ID` on a CommonRoad road: a lanelet's id is its lane's).
     #[serde(alias = "lanelet")]
@@ -269,6 +279,11 @@ pub struct VehicleSpec {
 
 fn default_true() -> bool {
     true
+}
+
+/// Whether `name` is the default vehicle model (left out of a written scenario).
+fn is_default_vehicle_model(name: &str) -> bool {
+    name == crate::vehicle_models::DEFAULT_VEHICLE_MODEL
 }
 
 /// Checks the vehicle list against the configuration; the error names the vehicle and field.

@@ -13,6 +13,8 @@
 //!   [`registry::BehaviourRegistry`] of [`registry::BehaviourFactory`]s (given a
 //!   [`registry::FactoryInput`]), with their parameter tables ([`PlannerParameters`],
 //!   [`ParamsTable`], [`ParamsError`]); the simulator's own drivers ([`drivers`], [`idm`]).
+//! - What moves each car: vehicle models by name ([`vehicle_models`]: `rapier`, `ks`, `st`,
+//!   `std`, or one's own), chosen by `sim.vehicle_model` or a vehicle's `vehicle_model`.
 //! - Watching a run: a [`TickObserver`] sees [`VehicleView`]s, [`PlanView`]s and
 //!   [`SimEvent`]s; metrics ([`metrics`], [`paper_metrics`]), safety checks ([`safety`]), the
 //!   V2V bus ([`v2v`]), phase timings ([`profile`]) and Rerun recordings ([`recording`]).
@@ -55,6 +57,7 @@ pub(crate) mod run_log;
 pub mod safety;
 pub mod spatial;
 pub mod v2v;
+pub mod vehicle_models;
 pub(crate) mod world;
 
 pub use error::SimError;

@@ -86,6 +86,7 @@ use crate::error::SimError;
 use crate::planner_params::{
     ParamsError, ParamsTable, ParsedParams, PlannerParameters, overlay, parse_typed,
 };
+use crate::vehicle_models::VehicleModelRegistry;
 use mergesim_types::Behaviour;
 
 /// What a factory gets to build one vehicle's behaviour.
@@ -131,10 +132,27 @@ enum Schema {
 
 /// Planner names → factories and parameter schemas (module doc). Names are kept sorted, so
 /// listing them is deterministic.
-#[derive(Clone, Default)]
+///
+/// It also carries the vehicle models the cars are spawned with
+/// ([`crate::vehicle_models::VehicleModelRegistry`], the built-in ones unless
+/// [`BehaviourRegistry::with_vehicle_models`] gives others), so that everything that takes a
+/// registry (the CLI, sweeps, grids, studies, Python) knows a user's models too.
+#[derive(Clone)]
 pub struct BehaviourRegistry {
     factories: BTreeMap<String, BehaviourFactory>,
     schemas: BTreeMap<String, Schema>,
+    vehicle_models: VehicleModelRegistry,
+}
+
+impl Default for BehaviourRegistry {
+    /// No planner; the built-in vehicle models.
+    fn default() -> Self {
+        Self {
+            factories: BTreeMap::new(),
+            schemas: BTreeMap::new(),
+            vehicle_models: VehicleModelRegistry::builtin(),
+        }
+    }
 }
 
 impl std::fmt::Debug for BehaviourRegistry {
@@ -166,9 +184,30 @@ fn pf_factory(kind: PlannerKind) -> BehaviourFactory {
 }
 
 impl BehaviourRegistry {
-    /// An empty registry.
+    /// A registry without planners (with the built-in vehicle models).
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// This registry with `models` as its vehicle models.
+    pub fn with_vehicle_models(mut self, models: VehicleModelRegistry) -> Self {
+        self.vehicle_models = models;
+        self
+    }
+
+    /// The vehicle models cars are spawned with.
+    pub fn vehicle_models(&self) -> &VehicleModelRegistry {
+        &self.vehicle_models
+    }
+
+    /// Adds a vehicle model (`VehicleModelRegistry::register`).
+    pub fn register_vehicle_model(
+        &mut self,
+        name: &str,
+        description: &str,
+        factory: crate::vehicle_models::VehicleModelFactory,
+    ) -> Result<(), SimError> {
+        self.vehicle_models.register(name, description, factory)
     }
 
     /// The paper's planners under their names (`PlannerKind::name`).

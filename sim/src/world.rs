@@ -85,6 +85,8 @@ pub struct World {
     goal_times: Vec<Option<f64>>,
     /// A vehicle left the map: the run has ended (`world/goals.rs`).
     left_map: bool,
+    /// Whether some car moves through Rapier's step (`VehicleModel::needs_physics_step`).
+    physics_needed: bool,
 }
 
 fn steps_for(period_s: f64, dt_s: f64) -> u64 {
@@ -138,6 +140,7 @@ impl World {
                 options.planner_override.as_deref(),
             )?);
         }
+        let agents_need_physics = agents.iter().any(|a| a.vehicle.needs_physics_step());
         let simulated_names: Vec<String> = specs.iter().map(|s| s.name.clone()).collect();
         let recorded = recorded::RecordedFleet::new(
             &config.recorded_traffic,
@@ -187,6 +190,7 @@ impl World {
             reported_edge_contacts: 0,
             goal_times: vec![None; specs.len()],
             left_map: false,
+            physics_needed: agents_need_physics,
         })
     }
 
@@ -296,9 +300,7 @@ impl World {
             let controls = agent.tracker.update(&kin, &agent.path, dt_s);
             agent.vehicle.set_controls(controls);
             let tracked = self.timing.then(Instant::now);
-            agent
-                .vehicle
-                .apply_forces(&mut self.physics, self.config.mu);
+            agent.vehicle.advance(&mut self.physics, self.config.mu);
             if let (Some(started), Some(tracked)) = (started, tracked) {
                 tracking += tracked - started;
                 forces += tracked.elapsed();
@@ -311,7 +313,11 @@ impl World {
         if !self.recorded.is_empty() {
             self.advance_recorded(t_s)?;
         }
-        self.physics.step();
+        // Skipped when no car needs it (`VehicleModel::needs_physics_step`): every car then
+        // moves itself, and nothing of the run reads Rapier's bodies.
+        if self.physics_needed {
+            self.physics.step();
+        }
         self.phase_since(Phase::Physics, started)?;
         self.step_index += 1;
         let t_s = self.time_s();

@@ -64,6 +64,7 @@ fn events_of(config: SimConfig, x_m: f64) -> (Vec<String>, u32) {
     let specs = [VehicleSpec {
         name: "weaver".into(),
         preset: "bmw_320i".into(),
+        vehicle_model: None,
         lane: Lane::Upper.into(),
         x_m,
         y_offset_m: 0.0,

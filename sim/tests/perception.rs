@@ -75,6 +75,7 @@ fn seen_by_the_first(config: SimConfig) -> Seen {
         .map(|(name, x_m)| VehicleSpec {
             name: name.into(),
             preset: "bmw_320i".into(),
+            vehicle_model: None,
             lane: Lane::Upper.into(),
             x_m,
             y_offset_m: 0.0,

@@ -38,6 +38,7 @@ fn spec(name: &str, x_m: f64, speed_mps: f64, driver: Driver) -> VehicleSpec {
     VehicleSpec {
         name: name.into(),
         preset: "bmw_320i".into(),
+        vehicle_model: None,
         lane: Lane::Upper.into(),
         x_m,
         y_offset_m: 0.0,

@@ -110,6 +110,12 @@ pub(crate) struct ScenarioArgs {
     /// [sim.planner] values apply on top of it.
     #[arg(long, value_name = "SET", value_parser = parse_params)]
     pub(crate) params: Option<ParameterSet>,
+    /// What moves every car, instead of the scenario's `vehicle_model` choices: `rapier` (rigid
+    /// body on four ray-cast wheels with Magic-Formula tyres, the default), `ks` (CommonRoad's
+    /// kinematic single track), `st` (single track, linear tyres) or `std` (single-track drift
+    /// model, Magic-Formula tyres); docs/vehicle_models.md.
+    #[arg(long, value_name = "MODEL")]
+    pub(crate) vehicle_model: Option<String>,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -322,14 +328,46 @@ pub(crate) fn command_with(registry: &Arc<BehaviourRegistry>) -> clap::Command {
         arg.value_parser(planner_parser(Arc::clone(registry)))
             .help(format!("{help} [registered: {names}]"))
     };
+    let models = registry.vehicle_models().names().join(", ");
+    let bind_model = |arg: clap::Arg| {
+        let help = arg.get_help().map(ToString::to_string).unwrap_or_default();
+        arg.value_parser(vehicle_model_parser(Arc::clone(registry)))
+            .help(format!("{help} [registered: {models}]"))
+    };
     Cli::command()
         .mut_arg("planner", bind)
-        .mut_subcommand("run", |c| c.mut_arg("planner", bind))
-        .mut_subcommand("compare", |c| c.mut_arg("planners", bind))
-        .mut_subcommand("sweep", |c| {
-            c.mut_arg("planner", bind).mut_arg("planners", bind)
+        .mut_arg("vehicle_model", bind_model)
+        .mut_subcommand("run", |c| {
+            c.mut_arg("planner", bind)
+                .mut_arg("vehicle_model", bind_model)
         })
-        .mut_subcommand("grid", |c| c.mut_arg("planners", bind))
+        .mut_subcommand("compare", |c| {
+            c.mut_arg("planners", bind)
+                .mut_arg("vehicle_model", bind_model)
+        })
+        .mut_subcommand("sweep", |c| {
+            c.mut_arg("planner", bind)
+                .mut_arg("planners", bind)
+                .mut_arg("vehicle_model", bind_model)
+        })
+        .mut_subcommand("grid", |c| {
+            c.mut_arg("planners", bind)
+                .mut_arg("vehicle_model", bind_model)
+        })
+}
+
+/// A vehicle model `registry` holds, else `unknown vehicle model 'X'; valid: …`.
+fn vehicle_model_parser(
+    registry: Arc<BehaviourRegistry>,
+) -> impl Fn(&str) -> Result<String, String> + Clone + Send + Sync + 'static {
+    move |text: &str| {
+        let models = registry.vehicle_models();
+        if models.contains(text) {
+            Ok(text.to_string())
+        } else {
+            Err(models.unknown(text))
+        }
+    }
 }
 
 /// A name `registry` holds, else [`crate::experiment::unknown_planner`]'s message.

@@ -29,6 +29,9 @@ pub enum VehicleError {
     /// The chassis rigid body is no longer in the physics world.
     #[error("vehicle chassis body is missing from the physics world")]
     MissingBody,
+    /// The car's figures in CommonRoad's terms are unusable by its models.
+    #[error(transparent)]
+    CommonRoadParams(#[from] crate::commonroad_models::CommonRoadParamsError),
 }
 
 impl VehicleError {

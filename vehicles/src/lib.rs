@@ -9,7 +9,7 @@
 //! ```text
 //! controls = tracker.update(&vehicle.kinematics(&world), &path, dt);
 //! vehicle.set_controls(controls);
-//! vehicle.apply_forces(&mut world, mu);   // every vehicle, in id order
+//! vehicle.advance(&mut world, mu);        // every vehicle, in id order (VehicleModel)
 //! world.step();
 //! ```
 //!
@@ -28,6 +28,9 @@
 //! - Errors: [`VehicleError`].
 //! - CommonRoad's vehicle models ks, st and std as pure functions (no rapier), with their
 //!   parameter sets and an RK4 step: [`commonroad_models`].
+//! - The vehicle-model seam [`VehicleModel`], implemented by [`Vehicle`] (`rapier`) and by
+//!   [`CommonRoadVehicle`] ([`CommonRoadModel`] `ks`, `st`, `std`, integrated with
+//!   [`CommonRoadIntegration`]'s steps; its state [`CommonRoadModelState`]).
 //!
 //! Each item has one path: a public module holding more than what the crate root names is
 //! the path of its items (`vehicles::tracker::Tracker`).
@@ -35,6 +38,7 @@
 
 pub mod collision_groups;
 pub mod commonroad_models;
+pub(crate) mod commonroad_vehicle;
 pub(crate) mod controls;
 pub(crate) mod error;
 pub(crate) mod kinematic_body;
@@ -48,8 +52,12 @@ pub(crate) mod single_track;
 pub(crate) mod tire;
 pub mod tracker;
 pub(crate) mod vehicle;
+pub(crate) mod vehicle_model;
 pub(crate) mod wheel;
 
+pub use commonroad_vehicle::{
+    CommonRoadIntegration, CommonRoadModel, CommonRoadModelState, CommonRoadVehicle,
+};
 pub use controls::{Controls, WHEEL_NAMES};
 pub use error::VehicleError;
 pub use kinematic_body::KinematicBox;
@@ -59,4 +67,5 @@ pub use physics_world::{GRAVITY_MPS2, PhysicsWorld};
 pub use presets::PRESET_NAMES;
 pub use single_track::{LinearSingleTrack, linear_yaw_rate_radps};
 pub use vehicle::{BodyBox, Vehicle};
+pub use vehicle_model::VehicleModel;
 pub use wheel::WheelTelemetry;

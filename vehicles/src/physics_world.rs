@@ -218,6 +218,26 @@ impl PhysicsWorld {
         self.world.detect_collisions(&(), &());
     }
 
+    /// Height of the road surface below (`x_m`, `y_m`) (road coordinates), searched downwards
+    /// from `probe_height_m` above z = 0; `None` if no road surface lies below. Refreshes the
+    /// scene queries first (a spawn check after colliders were added).
+    pub(crate) fn ground_height_m(
+        &mut self,
+        x_m: f64,
+        y_m: f64,
+        probe_height_m: f64,
+    ) -> Option<f64> {
+        self.refresh_queries();
+        // Rapier's coordinates are relative to the world's local origin.
+        let [x_local_m, y_local_m] = self.to_local_m([x_m, y_m]);
+        let probe = Ray::new(
+            Vector::new(x_local_m as Real, y_local_m as Real, probe_height_m as Real),
+            Vector::new(0.0, 0.0, -1.0),
+        );
+        self.cast_road_ray(&probe, (2.0 * probe_height_m) as Real)
+            .map(|hit| probe_height_m - f64::from(hit.time_of_impact))
+    }
+
     /// One rapier step of `dt_s`.
     pub fn step(&mut self) {
         self.world.step();

@@ -29,7 +29,7 @@ use crate::wheel::{
 pub const MU_RANGE: (f64, f64) = (0.01, 3.0);
 
 /// Height above the spawn point from which the ground is searched (m).
-const SPAWN_PROBE_HEIGHT_M: f64 = 50.0;
+pub(crate) const SPAWN_PROBE_HEIGHT_M: f64 = 50.0;
 
 /// Below this horizontal speed the sideslip angle is reported as 0 (m/s).
 const SIDESLIP_MIN_SPEED_MPS: f64 = 0.1;
@@ -42,6 +42,25 @@ pub struct BodyBox {
     /// Centre of the box relative to the CoG, body frame (m). The box is centred on the
     /// wheelbase midpoint (equal overhangs; CommonRoad gives no overhangs).
     pub center_offset_m: [f64; 3],
+}
+
+impl BodyBox {
+    /// The chassis box of a car of `params`: its length × width, from its ground clearance to
+    /// its body height, centred on the wheelbase midpoint.
+    pub fn of(params: &VehicleParams) -> Self {
+        BodyBox {
+            half_extents_m: [
+                0.5 * params.length_m,
+                0.5 * params.width_m,
+                0.5 * (params.body_height_m - params.ground_clearance_m),
+            ],
+            center_offset_m: [
+                0.5 * (params.cog_to_front_axle_m - params.cog_to_rear_axle_m),
+                0.0,
+                0.5 * (params.body_height_m + params.ground_clearance_m) - params.cog_height_m,
+            ],
+        }
+    }
 }
 
 /// A simulated car.
@@ -152,17 +171,11 @@ impl Vehicle {
                 "must be finite and >= 0",
             ));
         }
-        world.refresh_queries();
+        let ground_z = world
+            .ground_height_m(x_m, y_m, SPAWN_PROBE_HEIGHT_M)
+            .ok_or(VehicleError::NoGround { x_m, y_m })?;
         // Rapier's coordinates are relative to the world's local origin.
         let [x_local_m, y_local_m] = world.to_local_m([x_m, y_m]);
-        let probe = Ray::new(
-            to_vector([x_local_m, y_local_m, SPAWN_PROBE_HEIGHT_M]),
-            Vector::new(0.0, 0.0, -1.0),
-        );
-        let ground_z = world
-            .cast_road_ray(&probe, (2.0 * SPAWN_PROBE_HEIGHT_M) as Real)
-            .map(|hit| SPAWN_PROBE_HEIGHT_M - f64::from(hit.time_of_impact))
-            .ok_or(VehicleError::NoGround { x_m, y_m })?;
 
         let g = world.gravity_mps2();
         let geometry = WheelGeometry::for_vehicle(params, g);
@@ -186,18 +199,7 @@ impl Vehicle {
             .additional_mass_properties(mass)
             .can_sleep(false)
             .build();
-        let body_box = BodyBox {
-            half_extents_m: [
-                0.5 * params.length_m,
-                0.5 * params.width_m,
-                0.5 * (params.body_height_m - params.ground_clearance_m),
-            ],
-            center_offset_m: [
-                0.5 * (params.cog_to_front_axle_m - params.cog_to_rear_axle_m),
-                0.0,
-                0.5 * (params.body_height_m + params.ground_clearance_m) - params.cog_height_m,
-            ],
-        };
+        let body_box = BodyBox::of(params);
         let collider = ColliderBuilder::cuboid(
             body_box.half_extents_m[0] as Real,
             body_box.half_extents_m[1] as Real,
@@ -277,30 +279,7 @@ impl Vehicle {
     /// `max_brake_torque_nm`]. Non-finite torques become 0; a non-finite steering angle keeps the
     /// previous target.
     pub fn set_controls(&mut self, controls: Controls) {
-        let p = &self.params;
-        let steer = if controls.steer_rad.is_finite() {
-            controls.steer_rad.clamp(-p.max_steer_rad, p.max_steer_rad)
-        } else {
-            self.controls.steer_rad
-        };
-        let clamp = |v: f64, max: f64| {
-            if v.is_finite() {
-                v.clamp(0.0, max)
-            } else {
-                0.0
-            }
-        };
-        let mut clamped = Controls {
-            steer_rad: steer,
-            ..Controls::default()
-        };
-        for i in 0..4 {
-            clamped.drive_torque_nm[i] =
-                clamp(controls.drive_torque_nm[i], p.max_drive_torque_wheel_nm(i));
-            clamped.brake_torque_nm[i] =
-                clamp(controls.brake_torque_nm[i], p.max_brake_torque_wheel_nm(i));
-        }
-        self.controls = clamped;
+        self.controls = controls.clamped(&self.params, self.controls.steer_rad);
     }
 
     /// Suspension and tyre forces for the coming step, at road friction `mu` (call once before

@@ -198,8 +198,10 @@ impl Scenario {
     /// `registry` does not hold, keys the schema does not know, values out of range and any
     /// table for a planner registered without parameters; the error names the file, line and
     /// field. Run it before any work with the registry the run uses (the loader runs it with
-    /// the built-in registry, skipping names it does not hold).
+    /// the built-in registry, skipping names it does not hold). It checks the scenario's
+    /// vehicle models against `registry` too ([`Scenario::check_vehicle_models`]).
     pub fn check_planners(&self, registry: &BehaviourRegistry) -> Result<(), ScenarioError> {
+        self.check_vehicle_models(registry)?;
         self.check_planner_tables(registry, false)
     }
 
