@@ -38,7 +38,6 @@ pub struct SimConfig {
     /// What moves every car without its own `vehicle_model` (`crate::vehicle_models`):
     /// `rapier` (the default: rigid body on ray-cast wheels), `ks`, `st` or `std` (CommonRoad's
     /// models), or a registered model of one's own.
-    #[serde(skip_serializing_if = "is_default_vehicle_model")]
     pub vehicle_model: String,
     /// Physics step (s): read once to build the physics world, which owns the step during a run
     /// (`vehicles::PhysicsWorld::dt_s`; the world's time and periods are counted in its steps).
@@ -279,11 +278,6 @@ pub struct VehicleSpec {
 
 fn default_true() -> bool {
     true
-}
-
-/// Whether `name` is the default vehicle model (left out of a written scenario).
-fn is_default_vehicle_model(name: &str) -> bool {
-    name == crate::vehicle_models::DEFAULT_VEHICLE_MODEL
 }
 
 /// Checks the vehicle list against the configuration; the error names the vehicle and field.
