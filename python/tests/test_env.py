@@ -134,3 +134,18 @@ def test_a_road_of_lanes_is_refused_not_misread() -> None:
         refused = "straight \\[sim.road\\] merge road only"
         with pytest.raises(mergesim.ScenarioError, match=refused):
             mergesim.MergeEnv(scenario=name)
+
+
+def test_a_commonroad_vehicle_model_steps_and_an_unknown_one_is_refused() -> None:
+    rapier = mergesim.MergeEnv(params=SHORT, randomise=False)
+    ks = mergesim.MergeEnv(params={"sim": {**SHORT["sim"], "vehicle_model": "ks"}}, randomise=False)
+    rapier.reset(seed=0)
+    ks.reset(seed=0)
+    for _ in range(15):
+        obs_r, _, _, _, _ = rapier.step(HOLD_LANE)
+        obs_k, _, terminated, truncated, _ = ks.step(HOLD_LANE)
+        assert not (terminated or truncated)
+    assert np.all(np.isfinite(obs_k))
+    assert not np.array_equal(obs_r, obs_k)  # another model moved the cars
+    with pytest.raises(mergesim.ScenarioError, match="unknown vehicle model 'bicycle'"):
+        mergesim.MergeEnv(params={"sim": {"vehicle_model": "bicycle"}})
