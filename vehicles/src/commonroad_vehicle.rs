@@ -1,155 +1,26 @@
-//! A car moved by one of CommonRoad's vehicle models (`ks`, `st`, `std`) instead of Rapier's
-//! rigid-body dynamics: the [`VehicleModel`] of the `ks`, `st` and `std` names.
-//!
-//! **The car.** The model reads the car's own figures ([`VehicleParams`], the same preset as a
-//! `rapier` car): mass, yaw inertia, axle distances, CoG height (also as the sprung mass's
-//! height h_s, which mergesim's parameters do not separate), wheel radius and inertia, torque
-//! shares, the steering-angle and steering-rate limits, and the Magic-Formula tyre (the
-//! presets' tyre is CommonRoad's; the camber terms and the slip-ratio side force `r_vy*`,
-//! which mergesim's tyre does not have, are CommonRoad's). On a road of friction μ:
-//! - the tyre's peak coefficients are μ (`p_dx1 = p_dy1 = μ`, as the `rapier` tyre's
-//!   D = μ·F_z), so the st model's axle cornering stiffness is −`p_ky1`·F_z whatever μ;
-//! - the acceleration limit a_max is the car's drive/brake limit (max torque / (R_w·m)),
-//!   and for `ks` and `st`, whose longitudinal motion has no tyre, also at most μ·g;
-//! - no power limit (v_S = v_max = 100 m/s) and no reversing (v_min = 0: a braking car stops,
-//!   and a speed the RK4 step leaves below 0 is set to 0).
-//!
-//! **Inputs.** The tracker's [`Controls`], clamped to the car's limits as for a `rapier` car,
-//! become CommonRoad's inputs: the steering velocity (δ_cmd − δ)/Δt that reaches the commanded
-//! angle in one physics step, within ±`max_steer_rate_radps` (the `rapier` car's steering
-//! actuator follows at the same rate), and the longitudinal acceleration
-//! (Σ drive torque − Σ brake torque) / (R_w·m). Both are held over the physics step and
-//! constrained inside the model ([`crate::commonroad_models::constraints`]).
-//!
-//! **Integration.** RK4 sub-steps no longer than [`CommonRoadIntegration`]'s for the model (the
-//! st sideslip and the std wheel-spin modes are stiff at low speed; step sizes in
-//! [`crate::commonroad_models::integrate`]).
-//!
-//! **ABS and traction control** (std only, where the car's `abs_enabled` /
-//! `traction_control_enabled` say so, as on every preset): ideal, as on the `rapier` car. After
-//! each sub-step a braked wheel is held at the tyre's peak braking slip and a driven wheel at its
-//! peak driving slip. CommonRoad's model has neither; without them a full brake locks the
-//! wheels and CommonRoad's tyre (its slip-ratio side force) spins the car.
-//!
-//! **In the world.** The pose goes to a Rapier kinematic box ([`KinematicBox`]) of the
-//! chassis' size, so a `rapier` car that touches it is pushed; the box is never pushed back, and
-//! two kinematic boxes pass through each other: the simulator's safety checks find every
-//! contact from the bodies' boxes, not from Rapier's contacts. The road is taken as flat at
-//! the spawn point's height (no pitch, roll or suspension).
-//!
-//! **Kinematics.** The centre of gravity's state: ks's rear-axle state is moved to the CoG
-//! (position + l_r along the heading; body velocities v and v·l_r·tan δ / L; yaw rate
-//! v·tan δ / L); st's and std's state is the CoG's (v_x = v cos β, v_y = v sin β).
-//! Accelerations are the change of the body-frame velocity over the step plus the rotation of
-//! the frame: a_x = Δv_x/Δt − v_y·ψ̇, a_y = Δv_y/Δt + v_x·ψ̇.
-
-use serde::{Deserialize, Serialize};
-
+//! [`CommonRoadVehicle`]: a car moved by one of CommonRoad's vehicle models (its doc says how).
 use crate::commonroad_models::{
-    CommonRoadInput, CommonRoadLongitudinalLimits, CommonRoadSteeringLimits, CommonRoadTireParams,
-    CommonRoadVehicleParams, KsState, StState, StdState, ks_step_rk4, st_step_rk4, std_step_rk4,
+    CommonRoadInput, CommonRoadVehicleParams, KsState, StState, StdState, ks_step_rk4, st_step_rk4,
+    std_step_rk4,
 };
 use crate::controls::Controls;
 use crate::error::VehicleError;
 use crate::kinematic_body::KinematicBox;
 use crate::kinematics::Kinematics;
 use crate::params::VehicleParams;
-use crate::physics_world::{GRAVITY_MPS2, PhysicsWorld};
+use crate::physics_world::PhysicsWorld;
 use crate::vehicle::{BodyBox, MU_RANGE, SPAWN_PROBE_HEIGHT_M};
 use crate::vehicle_model::VehicleModel;
 
-/// Top speed of the models here (m/s): no limit in practice, as for a `rapier` car.
-const COMMONROAD_VEHICLE_MAX_SPEED_MPS: f64 = 100.0;
+mod car_params;
+mod model_choice;
+mod slip_control;
+
+pub use model_choice::{CommonRoadIntegration, CommonRoadModel};
+use slip_control::WheelSlipControl;
 
 /// Below this speed the sideslip angle is reported as 0 (m/s), as for a `rapier` car.
 const SIDESLIP_MIN_SPEED_MPS: f64 = 0.1;
-
-/// Which of CommonRoad's models moves the car.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum CommonRoadModel {
-    /// Kinematic single track (no tyres, no sideslip of the rear axle).
-    Ks,
-    /// Single track with linear tyres (no saturation: valid while |a_y| ≲ 0.4·μ·g).
-    St,
-    /// Single-track drift model: Magic-Formula tyres that saturate at μ, wheel spin.
-    Std,
-}
-
-impl CommonRoadModel {
-    /// Every model, in the order of their fidelity.
-    pub const ALL: [CommonRoadModel; 3] = [Self::Ks, Self::St, Self::Std];
-
-    /// The registered name: `ks`, `st` or `std`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Ks => "ks",
-            Self::St => "st",
-            Self::Std => "std",
-        }
-    }
-
-    /// The model of a registered name.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|m| m.name() == name)
-    }
-}
-
-/// Step sizes of the CommonRoad vehicles' RK4 integration (s). Each physics step is cut into
-/// the fewest equal sub-steps no longer than the model's limit.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct CommonRoadIntegration {
-    /// Longest sub-step of the ks model (s).
-    pub ks_max_substep_s: f64,
-    /// Longest sub-step of the st model (s): its sideslip mode, λ ≈ −215 s⁻¹·(1 m/s)/v for the
-    /// BMW, is stable with 1 ms down to its switch to the kinematic model at 0.1 m/s.
-    pub st_max_substep_s: f64,
-    /// Longest sub-step of the std model at or above `std_slow_speed_mps` (s).
-    pub std_max_substep_s: f64,
-    /// Longest sub-step of the std model below `std_slow_speed_mps` (s): its wheel-spin modes
-    /// stiffen as 1/(wheel ground speed).
-    pub std_slow_max_substep_s: f64,
-    /// Speed below which the std model takes the slow sub-step (m/s).
-    pub std_slow_speed_mps: f64,
-}
-
-impl Default for CommonRoadIntegration {
-    fn default() -> Self {
-        Self {
-            ks_max_substep_s: 0.01,
-            st_max_substep_s: 1e-3,
-            std_max_substep_s: 1e-3,
-            std_slow_max_substep_s: 1e-4,
-            std_slow_speed_mps: 5.0,
-        }
-    }
-}
-
-impl CommonRoadIntegration {
-    /// Checks that every step is finite and > 0 and the speed finite and ≥ 0.
-    pub fn validate(&self) -> Result<(), VehicleError> {
-        for (name, value) in [
-            ("ks_max_substep_s", self.ks_max_substep_s),
-            ("st_max_substep_s", self.st_max_substep_s),
-            ("std_max_substep_s", self.std_max_substep_s),
-            ("std_slow_max_substep_s", self.std_slow_max_substep_s),
-        ] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(VehicleError::invalid(name, value, "must be finite and > 0"));
-            }
-        }
-        let v = self.std_slow_speed_mps;
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(VehicleError::invalid(
-                "std_slow_speed_mps",
-                v,
-                "must be finite and >= 0",
-            ));
-        }
-        Ok(())
-    }
-}
 
 /// The state of the model that moves the car, in CommonRoad's terms.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -162,72 +33,50 @@ pub enum CommonRoadModelState {
     Std(StdState),
 }
 
-impl CommonRoadVehicleParams {
-    /// The car of `p` in CommonRoad's terms on a road of friction `mu`, for `model` (module
-    /// doc of [`crate::commonroad_vehicle`]).
-    pub fn from_vehicle_params(p: &VehicleParams, model: CommonRoadModel, mu: f64) -> Self {
-        let drive_limit_mps2 = p.max_drive_torque_nm / (p.wheel_radius_m * p.mass_kg);
-        let brake_limit_mps2 = p.max_brake_torque_nm / (p.wheel_radius_m * p.mass_kg);
-        let mut max_acceleration_mps2 = drive_limit_mps2.max(brake_limit_mps2);
-        if model != CommonRoadModel::Std {
-            max_acceleration_mps2 = max_acceleration_mps2.min(mu * GRAVITY_MPS2);
-        }
-        let t = &p.tire;
-        let reference = CommonRoadTireParams::default();
-        Self {
-            length_m: p.length_m,
-            width_m: p.width_m,
-            mass_kg: p.mass_kg,
-            yaw_inertia_kgm2: p.yaw_inertia_kgm2,
-            cog_to_front_axle_m: p.cog_to_front_axle_m,
-            cog_to_rear_axle_m: p.cog_to_rear_axle_m,
-            cog_height_m: p.cog_height_m,
-            sprung_cog_height_m: p.cog_height_m,
-            wheel_inertia_kgm2: p.wheel_inertia_kgm2,
-            wheel_radius_m: p.wheel_radius_m,
-            brake_torque_front_share: p.brake_torque_front_share,
-            drive_torque_front_share: p.drive_torque_front_share,
-            steering: CommonRoadSteeringLimits {
-                min_angle_rad: -p.max_steer_rad,
-                max_angle_rad: p.max_steer_rad,
-                min_steering_velocity_radps: -p.max_steer_rate_radps,
-                max_steering_velocity_radps: p.max_steer_rate_radps,
-            },
-            longitudinal: CommonRoadLongitudinalLimits {
-                min_speed_mps: 0.0,
-                max_speed_mps: COMMONROAD_VEHICLE_MAX_SPEED_MPS,
-                switching_speed_mps: COMMONROAD_VEHICLE_MAX_SPEED_MPS,
-                max_acceleration_mps2,
-            },
-            tire: CommonRoadTireParams {
-                p_cx1: t.p_cx1,
-                p_dx1: mu,
-                p_ex1: t.p_ex1,
-                p_kx1: t.p_kx1,
-                p_hx1: t.p_hx1,
-                p_vx1: t.p_vx1,
-                r_bx1: t.r_bx1,
-                r_bx2: t.r_bx2,
-                r_cx1: t.r_cx1,
-                r_ex1: t.r_ex1,
-                r_hx1: t.r_hx1,
-                p_cy1: t.p_cy1,
-                p_dy1: mu,
-                p_ey1: t.p_ey1,
-                p_ky1: t.p_ky1,
-                r_by1: t.r_by1,
-                r_by2: t.r_by2,
-                r_by3: t.r_by3,
-                r_cy1: t.r_cy1,
-                r_ey1: t.r_ey1,
-                r_hy1: t.r_hy1,
-                ..reference
-            },
-        }
-    }
-}
-
-/// A car moved by a CommonRoad model (module doc).
+/// A car moved by one of CommonRoad's vehicle models (`ks`, `st`, `std`) instead of Rapier's
+/// rigid-body dynamics: the [`VehicleModel`] of the `ks`, `st` and `std` names.
+///
+/// **The car.** The model reads the car's own figures ([`VehicleParams`], the same preset as a
+/// `rapier` car): mass, yaw inertia, axle distances, CoG height (also as the sprung mass's
+/// height h_s, which mergesim's parameters do not separate), wheel radius and inertia, torque
+/// shares, the steering-angle and steering-rate limits, and the Magic-Formula tyre (the
+/// presets' tyre is CommonRoad's; the camber terms and the slip-ratio side force `r_vy*`,
+/// which mergesim's tyre does not have, are CommonRoad's). On a road of friction μ:
+/// - the tyre's peak coefficients are μ (`p_dx1 = p_dy1 = μ`, as the `rapier` tyre's
+///   D = μ·F_z), so the st model's axle cornering stiffness is −`p_ky1`·F_z whatever μ;
+/// - the acceleration limit a_max is the car's drive/brake limit (max torque / (R_w·m)),
+///   and for `ks` and `st`, whose longitudinal motion has no tyre, also at most μ·g;
+/// - no power limit (v_S = v_max = 100 m/s) and no reversing (v_min = 0: a braking car stops,
+///   and a speed the RK4 step leaves below 0 is set to 0).
+///
+/// **Inputs.** The tracker's [`Controls`], clamped to the car's limits as for a `rapier` car,
+/// become CommonRoad's inputs: the steering velocity (δ_cmd − δ)/Δt that reaches the commanded
+/// angle in one physics step, within ±`max_steer_rate_radps` (the `rapier` car's steering
+/// actuator follows at the same rate), and the longitudinal acceleration
+/// (Σ drive torque − Σ brake torque) / (R_w·m). Both are held over the physics step and
+/// constrained inside the model ([`crate::commonroad_models::constraints`]).
+///
+/// **Integration.** RK4 sub-steps no longer than [`CommonRoadIntegration`]'s for the model (the
+/// st sideslip and the std wheel-spin modes are stiff at low speed; step sizes in
+/// [`crate::commonroad_models::integrate`]).
+///
+/// **ABS and traction control** (std only, where the car's `abs_enabled` /
+/// `traction_control_enabled` say so, as on every preset): ideal, as on the `rapier` car. After
+/// each sub-step a braked wheel is held at the tyre's peak braking slip and a driven wheel at its
+/// peak driving slip. CommonRoad's model has neither; without them a full brake locks the
+/// wheels and CommonRoad's tyre (its slip-ratio side force) spins the car.
+///
+/// **In the world.** The pose goes to a Rapier kinematic box ([`KinematicBox`]) of the
+/// chassis' size, so a `rapier` car that touches it is pushed; the box is never pushed back, and
+/// two kinematic boxes pass through each other: the simulator's safety checks find every
+/// contact from the bodies' boxes, not from Rapier's contacts. The road is taken as flat at
+/// the spawn point's height (no pitch, roll or suspension).
+///
+/// **Kinematics.** The centre of gravity's state: ks's rear-axle state is moved to the CoG
+/// (position + l_r along the heading; body velocities v and v·l_r·tan δ / L; yaw rate
+/// v·tan δ / L); st's and std's state is the CoG's (v_x = v cos β, v_y = v sin β).
+/// Accelerations are the change of the body-frame velocity over the step plus the rotation of
+/// the frame: a_x = Δv_x/Δt − v_y·ψ̇, a_y = Δv_y/Δt + v_x·ψ̇.
 pub struct CommonRoadVehicle {
     model: CommonRoadModel,
     params: VehicleParams,
@@ -502,68 +351,6 @@ fn box_pose_m(cog_pose_m: [f64; 3], body_box: &BodyBox) -> [f64; 3] {
     let [ox, oy, _] = body_box.center_offset_m;
     let (s, c) = yaw.sin_cos();
     [x + ox * c - oy * s, y + ox * s + oy * c, yaw]
-}
-
-/// Below this wheel ground speed the std wheels' slip is not controlled (m/s).
-const SLIP_CONTROL_MIN_SPEED_MPS: f64 = 1.0;
-
-/// The std car's ABS and traction control, ideal as the `rapier` car's (`crate::wheel`): after
-/// each RK4 sub-step a braked wheel turning slower than the tyre's peak braking slip, or a
-/// driven wheel turning faster than its peak driving slip, is set to that slip. CommonRoad's
-/// std model has neither; without them a full brake locks the wheels, and CommonRoad's tyre
-/// (its slip-ratio side force `r_vy*`) then spins the car.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct WheelSlipControl {
-    /// Longest braking slip ratio s = 1 − R_w ω / u_w (at the force's peak), or `None`: no ABS.
-    brake_slip: Option<f64>,
-    /// Most negative driving slip ratio, or `None`: no traction control.
-    drive_slip: Option<f64>,
-}
-
-impl WheelSlipControl {
-    /// The control of a car of `params` on a road of friction `mu`: the peak of its
-    /// Magic-Formula longitudinal curve, S_Hx off centre (CommonRoad's κ_x = −s + p_hx1).
-    fn of(params: &VehicleParams, mu: f64) -> Option<Self> {
-        if !params.abs_enabled && !params.traction_control_enabled {
-            return None;
-        }
-        let peak = crate::tire::TireCurves::new(&params.tire, mu).peak_slip_ratio;
-        let shift = params.tire.p_hx1;
-        Some(Self {
-            brake_slip: params.abs_enabled.then_some(shift + peak),
-            drive_slip: params.traction_control_enabled.then_some(shift - peak),
-        })
-    }
-
-    /// `s` with each wheel's spin held within the slip limits for acceleration input `a`.
-    fn hold(
-        &self,
-        mut s: StdState,
-        acceleration_mps2: f64,
-        p: &CommonRoadVehicleParams,
-    ) -> StdState {
-        let (lf, rw) = (p.cog_to_front_axle_m, p.wheel_radius_m);
-        let (sin_b, cos_b) = s.slip_angle_rad.sin_cos();
-        let (sin_d, cos_d) = s.steering_angle_rad.sin_cos();
-        let v = s.speed_mps;
-        let u_front = v * cos_b * cos_d + (v * sin_b + lf * s.yaw_rate_radps) * sin_d;
-        let u_rear = v * cos_b;
-        let limit = |omega: f64, u_mps: f64| -> f64 {
-            if u_mps < SLIP_CONTROL_MIN_SPEED_MPS {
-                return omega;
-            }
-            match (acceleration_mps2 < 0.0, self.brake_slip, self.drive_slip) {
-                (true, Some(slip), _) => omega.max((1.0 - slip) * u_mps / rw),
-                (false, _, Some(slip)) if acceleration_mps2 > 0.0 => {
-                    omega.min((1.0 - slip) * u_mps / rw)
-                }
-                _ => omega,
-            }
-        };
-        s.front_wheel_speed_radps = limit(s.front_wheel_speed_radps, u_front);
-        s.rear_wheel_speed_radps = limit(s.rear_wheel_speed_radps, u_rear);
-        s
-    }
 }
 
 /// One physics step of `dt_s` of `state` in `n` RK4 sub-steps, the input held; a speed left
