@@ -315,13 +315,67 @@ pub struct Tracker {
     debug: TrackerDebug,
 }
 
+/// Largest coordinate magnitude (m) up to which [`project`] skips segments by their bounding
+/// boxes; beyond it every segment is computed (the skip's rounding margin assumes this scale).
+const PRUNE_COORDINATE_LIMIT_M: f64 = 1e7;
+
+/// Absolute margin (m) of the bounding-box skip in [`project`]: far above the rounding of the
+/// projected point (a few ulps of coordinates below [`PRUNE_COORDINATE_LIMIT_M`], ~1e-8 m).
+const PRUNE_MARGIN_M: f64 = 1e-6;
+
+/// Whether the axis-aligned box around `a` and `b` lies farther than `distance_m` from
+/// (`x`, `y`) along X or along Y (both points beyond it on the same side): then every point of
+/// the segment is farther than `distance_m`. Plain comparisons, cheapest when the path runs
+/// along X.
+fn box_beyond(
+    a: &mergesim_types::PathPoint,
+    b: &mergesim_types::PathPoint,
+    x: f64,
+    y: f64,
+    distance_m: f64,
+) -> bool {
+    (a.x_m - x > distance_m && b.x_m - x > distance_m)
+        || (x - a.x_m > distance_m && x - b.x_m > distance_m)
+        || (a.y_m - y > distance_m && b.y_m - y > distance_m)
+        || (y - a.y_m > distance_m && y - b.y_m > distance_m)
+}
+
+/// Whether every point of `path` is within [`PRUNE_COORDINATE_LIMIT_M`] (so finite), the
+/// condition of [`project`]'s bounding-box skip.
+fn path_is_prunable(path: &[mergesim_types::PathPoint]) -> bool {
+    path.iter()
+        .all(|p| p.x_m.abs() <= PRUNE_COORDINATE_LIMIT_M && p.y_m.abs() <= PRUNE_COORDINATE_LIMIT_M)
+}
+
 /// Projection of a point on a polyline: segment index, parameter along it (clamped to [0, 1]
 /// except before the first and after the last point), squared distance.
-fn project(path: &[mergesim_types::PathPoint], x: f64, y: f64) -> (usize, f64, f64) {
+///
+/// Segments are visited in order and the first one with the smallest squared distance wins.
+/// An inner segment whose bounding box is, by a margin, farther than the best distance so far
+/// cannot win (its computed squared distance would be larger), so it is skipped without the
+/// projection: the result is bit for bit the one of computing every segment.
+///
+/// `path_is_prunable` must be [`path_is_prunable`] of `path` (computed once per path by the
+/// caller).
+fn project(
+    path: &[mergesim_types::PathPoint],
+    path_is_prunable: bool,
+    x: f64,
+    y: f64,
+) -> (usize, f64, f64) {
     let mut best = (0, 0.0, f64::INFINITY);
+    // Distances beyond this cannot beat `best` (m); infinite until a first candidate.
+    let mut skip_beyond_m = f64::INFINITY;
+    let may_skip = path_is_prunable
+        && x.abs() <= PRUNE_COORDINATE_LIMIT_M
+        && y.abs() <= PRUNE_COORDINATE_LIMIT_M;
     let last = path.len().saturating_sub(2);
     for i in 0..path.len().saturating_sub(1) {
         let (a, b) = (&path[i], &path[i + 1]);
+        // The first and last segments extend beyond their points: never skipped.
+        if may_skip && i != 0 && i != last && box_beyond(a, b, x, y, skip_beyond_m) {
+            continue;
+        }
         let (dx, dy) = (b.x_m - a.x_m, b.y_m - a.y_m);
         let len_sq = dx * dx + dy * dy;
         let mut t = if len_sq > 0.0 {
@@ -336,6 +390,7 @@ fn project(path: &[mergesim_types::PathPoint], x: f64, y: f64) -> (usize, f64, f
         let d = (px - x) * (px - x) + (py - y) * (py - y);
         if d < best.2 {
             best = (i, t, d);
+            skip_beyond_m = d.sqrt() * (1.0 + 1e-9) + PRUNE_MARGIN_M;
         }
     }
     best
@@ -429,7 +484,8 @@ impl Tracker {
         let p = &self.params;
         let lookahead = (p.lookahead_min_m + p.lookahead_time_s * kin.speed_mps.max(0.0))
             .clamp(p.lookahead_min_m, p.lookahead_max_m);
-        let (seg, t, _) = project(path, rear[0], rear[1]);
+        let prunable = path_is_prunable(path);
+        let (seg, t, _) = project(path, prunable, rear[0], rear[1]);
         let target = walk(path, seg, t, lookahead);
         let (dx, dy) = (target[0] - rear[0], target[1] - rear[1]);
         let distance = dx.hypot(dy).max(1e-3);
@@ -437,7 +493,7 @@ impl Tracker {
         let steer = (2.0 * self.wheelbase_m * alpha.sin() / distance).atan();
 
         // Speed: the path point nearest ahead of the CoG.
-        let (seg_cog, t_cog, dist_sq) = project(path, kin.x_m, kin.y_m);
+        let (seg_cog, t_cog, dist_sq) = project(path, prunable, kin.x_m, kin.y_m);
         let ahead = if seg_cog == 0 && t_cog < 0.0 {
             0
         } else {
@@ -516,6 +572,44 @@ mod tests {
             "{} vs {expected}",
             controls.steer_rad
         );
+    }
+
+    #[test]
+    fn the_box_skip_of_project_changes_no_bit() {
+        // A small LCG: paths that curve, double back, repeat points; points near and far.
+        let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for case in 0..400 {
+            let n = 2 + case % 25;
+            let (mut x, mut y, mut heading) = (1000.0 * next() - 500.0, 20.0 * next(), 0.0);
+            let mut path = Vec::with_capacity(n);
+            for _ in 0..n {
+                path.push(point(x, y, 10.0));
+                heading += (next() - 0.5) * if case % 3 == 0 { 3.0 } else { 0.3 };
+                let step_m = if next() < 0.1 { 0.0 } else { 2.5 * next() };
+                x += step_m * f64::cos(heading);
+                y += step_m * f64::sin(heading);
+            }
+            assert!(path_is_prunable(&path));
+            for _ in 0..50 {
+                let q = &path[(next() * n as f64) as usize % n];
+                let spread_m = [0.01, 1.0, 10.0, 100.0][(next() * 4.0) as usize % 4];
+                let (qx, qy) = (
+                    q.x_m + spread_m * (next() - 0.5),
+                    q.y_m + spread_m * (next() - 0.5),
+                );
+                let pruned = project(&path, true, qx, qy);
+                let exhaustive = project(&path, false, qx, qy);
+                assert_eq!(pruned.0, exhaustive.0);
+                assert_eq!(pruned.1.to_bits(), exhaustive.1.to_bits());
+                assert_eq!(pruned.2.to_bits(), exhaustive.2.to_bits());
+            }
+        }
     }
 
     #[test]

@@ -88,14 +88,26 @@ pub use events::{
 pub use params::{DEFAULT_PAIR_RANGE_M, SAFETY_BOUNDS, SafetyError, SafetyParams};
 pub use recorded_pairs::recorded_is_behind;
 
-/// The bounding-circle lower bound of a pair's gap (m, ≥ 0) and its relative speed (m/s): what
-/// decides whether the pair is followed, and which exact queries it needs.
-fn pair_bounds(a: &BodyState, b: &BodyState) -> (f64, f64) {
+/// The bounding-circle figures of a pair at one instant: what decides whether the pair is
+/// followed, and which exact queries it needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PairBounds {
+    /// Centre distance minus both bounding radii, floored at 0 (m): a lower bound of the gap.
+    gap_lower_bound_m: f64,
+    /// Norm of the relative world-frame velocity (m/s).
+    relative_speed_mps: f64,
+}
+
+/// [`PairBounds`] of `a` and `b`, given their bounding radii `radius_a_m` and `radius_b_m`
+/// ([`BodyState::bounding_radius_m`], computed once per body and instant by the caller).
+fn pair_bounds(a: &BodyState, radius_a_m: f64, b: &BodyState, radius_b_m: f64) -> PairBounds {
     let centre_distance_m = (b.x_m - a.x_m).hypot(b.y_m - a.y_m);
-    let gap_lower_bound_m =
-        (centre_distance_m - a.bounding_radius_m() - b.bounding_radius_m()).max(0.0);
+    let gap_lower_bound_m = (centre_distance_m - radius_a_m - radius_b_m).max(0.0);
     let relative_speed_mps = (b.vx_mps - a.vx_mps).hypot(b.vy_mps - a.vy_mps);
-    (gap_lower_bound_m, relative_speed_mps)
+    PairBounds {
+        gap_lower_bound_m,
+        relative_speed_mps,
+    }
 }
 
 /// One straight piece of a road edge, in world coordinates.
@@ -290,8 +302,9 @@ impl SafetyMonitor {
         self.report.new_edge_contacts.clear();
         self.report.min_ttc_s = None;
 
-        for (i, j) in self.followed_pairs(bodies) {
-            self.check_pair(t_s, previous_t_s, dt_s, &bodies[i], &bodies[j])?;
+        let radii_m: Vec<f64> = bodies.iter().map(BodyState::bounding_radius_m).collect();
+        for (i, j, bounds) in self.followed_pairs(bodies, &radii_m) {
+            self.check_pair(t_s, previous_t_s, dt_s, &bodies[i], &bodies[j], bounds)?;
         }
         if self.params.check_road_edges {
             let recorded_from = self.recorded_from;
@@ -320,19 +333,23 @@ impl SafetyMonitor {
         Ok(&self.report)
     }
 
-    /// Whether the monitor follows the pair at this instant (module doc).
-    fn follows(&self, a: &BodyState, b: &BodyState) -> bool {
-        let (gap_lower_bound_m, relative_speed_mps) = pair_bounds(a, b);
-        gap_lower_bound_m
+    /// Whether the monitor follows a pair with these bounds at this instant (module doc).
+    fn follows(&self, bounds: PairBounds) -> bool {
+        bounds.gap_lower_bound_m
             <= self
                 .params
                 .pair_range_m
-                .max(relative_speed_mps * self.params.ttc_horizon_s)
+                .max(bounds.relative_speed_mps * self.params.ttc_horizon_s)
     }
 
-    /// The pairs (indices into `bodies`, i < j) followed at this instant, in id order: from the
-    /// X sweep, or from all pairs without the broad phase.
-    fn followed_pairs(&self, bodies: &[BodyState]) -> Vec<(usize, usize)> {
+    /// The pairs (indices into `bodies`, i < j) followed at this instant, with their bounds, in
+    /// id order: from the X sweep, or from all pairs without the broad phase. `radii_m` holds
+    /// each body's bounding radius.
+    fn followed_pairs(
+        &self,
+        bodies: &[BodyState],
+        radii_m: &[f64],
+    ) -> Vec<(usize, usize, PairBounds)> {
         let candidates: Vec<(usize, usize)> = if self.params.broad_phase {
             let xs: Vec<f64> = bodies.iter().map(|b| b.x_m).collect();
             XSweep::new(&xs).pairs_within_window(self.sweep_window_m(bodies))
@@ -343,9 +360,12 @@ impl SafetyMonitor {
         };
         candidates
             .into_iter()
-            .filter(|&(i, j)| {
-                !self.skips_pair(bodies[i].id, bodies[j].id) && self.follows(&bodies[i], &bodies[j])
+            .filter(|&(i, j)| !self.skips_pair(bodies[i].id, bodies[j].id))
+            .map(|(i, j)| {
+                let bounds = pair_bounds(&bodies[i], radii_m[i], &bodies[j], radii_m[j]);
+                (i, j, bounds)
             })
+            .filter(|&(_, _, bounds)| self.follows(bounds))
             .collect()
     }
 

@@ -5,11 +5,42 @@ use parry3d::math::{Pose, Vector};
 use parry3d::query::{self, ShapeCastOptions, ShapeCastStatus};
 use parry3d::shape::Cuboid;
 
+use std::collections::btree_map::Entry;
+
 use super::{
-    BodyState, CollisionEvent, PairInstant, PairState, SafetyError, SafetyMonitor, pair_bounds,
+    BodyState, CollisionEvent, PairBounds, PairInstant, PairState, SafetyError, SafetyMonitor,
 };
 
+/// The two boxes of a pair as parry sees them, expressed around the pair's midpoint (module
+/// doc, "Precision"); built on first use, since most instants need no exact query.
+struct PairBoxes<'a> {
+    a: &'a BodyState,
+    b: &'a BodyState,
+    built: Option<[(Pose, Cuboid); 2]>,
+}
+
+impl<'a> PairBoxes<'a> {
+    /// The boxes of `a` and `b`, not built yet.
+    fn new(a: &'a BodyState, b: &'a BodyState) -> Self {
+        Self { a, b, built: None }
+    }
+
+    /// Poses and cuboids of `a` and `b`, built on the first call.
+    fn get(&mut self) -> [(Pose, Cuboid); 2] {
+        let (a, b) = (self.a, self.b);
+        *self.built.get_or_insert_with(|| {
+            let mid_x_m = 0.5 * (a.x_m + b.x_m);
+            let mid_y_m = 0.5 * (a.y_m + b.y_m);
+            [
+                local_box(a, mid_x_m, mid_y_m),
+                local_box(b, mid_x_m, mid_y_m),
+            ]
+        })
+    }
+}
+
 impl SafetyMonitor {
+    /// Checks the followed pair (`a`, `b`) with its bounding-circle `bounds` at instant `t_s`.
     pub(super) fn check_pair(
         &mut self,
         t_s: f64,
@@ -17,24 +48,32 @@ impl SafetyMonitor {
         dt_s: f64,
         a: &BodyState,
         b: &BodyState,
+        bounds: PairBounds,
     ) -> Result<(), SafetyError> {
         let ttc_horizon_s = self.params.ttc_horizon_s;
         let ttc_threshold_s = self.params.ttc_threshold_s;
-        let (gap_lower_bound_m, relative_speed_mps) = pair_bounds(a, b);
+        let PairBounds {
+            gap_lower_bound_m,
+            relative_speed_mps,
+        } = bounds;
+        // Pure; computed before the map entry borrows `self.pairs`.
+        let caused_by_replay = self.caused_by_replay(a, b);
 
         let key = (a.id, b.id);
-        let state = self.pairs.get(&key).copied();
+        // One look-up: the entry is read now and written at the end.
+        let entry = self.pairs.entry(key);
+        let state = match &entry {
+            Entry::Occupied(occupied) => Some(*occupied.get()),
+            Entry::Vacant(_) => None,
+        };
         // Continuity with the previous instant: only if the pair was visited then.
         let continuing = state.filter(|s| previous_t_s == Some(s.last_seen_t_s));
 
-        // Both boxes expressed around the pair's midpoint (see "Precision").
-        let mid_x_m = 0.5 * (a.x_m + b.x_m);
-        let mid_y_m = 0.5 * (a.y_m + b.y_m);
-        let (pose_a, box_a) = local_box(a, mid_x_m, mid_y_m);
-        let (pose_b, box_b) = local_box(b, mid_x_m, mid_y_m);
+        let mut boxes = PairBoxes::new(a, b);
 
         let tolerance_m = self.params.contact_tolerance_m;
         let overlapping = if gap_lower_bound_m <= 0.0 {
+            let [(pose_a, box_a), (pose_b, box_b)] = boxes.get();
             query::intersection_test(&pose_a, &box_a, &pose_b, &box_b)
                 .map_err(|e| SafetyError::Unsupported(format!("{e:?}")))?
                 .intersecting
@@ -46,6 +85,7 @@ impl SafetyMonitor {
         let (gap_m, gap_is_lower_bound) = if overlapping {
             (0.0, false)
         } else if gap_lower_bound_m < current_min_gap_m || gap_lower_bound_m <= tolerance_m {
+            let [(pose_a, box_a), (pose_b, box_b)] = boxes.get();
             let d = query::distance(&pose_a, &box_a, &pose_b, &box_b)
                 .map_err(|e| SafetyError::Unsupported(format!("{e:?}")))?
                 .distance;
@@ -61,6 +101,7 @@ impl SafetyMonitor {
         } else if gap_lower_bound_m > relative_speed_mps * ttc_horizon_s {
             None
         } else {
+            let [(pose_a, box_a), (pose_b, box_b)] = boxes.get();
             let options = ShapeCastOptions {
                 max_time_of_impact: ttc_horizon_s as f32,
                 target_distance: 0.0,
@@ -117,7 +158,7 @@ impl SafetyMonitor {
                 id_b: b.id,
                 t_contact_estimate_s,
                 relative_speed_mps,
-                caused_by_replay: self.caused_by_replay(a, b),
+                caused_by_replay,
             });
         }
         if !gap_is_lower_bound && gap_m < s.min_gap_m {
@@ -139,7 +180,12 @@ impl SafetyMonitor {
         s.in_contact = intersecting;
         s.ttc_at_last_seen_s = ttc_s;
         s.last_seen_t_s = t_s;
-        self.pairs.insert(key, s);
+        match entry {
+            Entry::Occupied(mut occupied) => *occupied.get_mut() = s,
+            Entry::Vacant(vacant) => {
+                vacant.insert(s);
+            }
+        }
 
         self.report.pairs.push(PairInstant {
             id_a: a.id,
