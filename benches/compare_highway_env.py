@@ -36,6 +36,8 @@ import tempfile
 import time
 import warnings
 
+from bench_common import cmd_out, cpu_model, loadavg, log
+
 
 def parse_args() -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -57,37 +59,6 @@ def parse_args() -> argparse.Namespace:
     return a
 
 
-def log(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
-
-
-def cmd_out(cmd: list[str], cwd: str | None = None) -> str:
-    try:
-        return subprocess.run(cmd, cwd=cwd, check=True, capture_output=True, text=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return ""
-
-
-def cpu_model() -> str:
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as f:
-            for line in f:
-                key, _, val = line.partition(":")
-                if key.strip() in ("model name", "Model", "Hardware", "cpu model"):
-                    return val.strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
-
-
-def _loadavg() -> str:
-    try:
-        with open("/proc/loadavg", encoding="utf-8") as f:
-            return " ".join(f.read().split()[:3])
-    except OSError:
-        return "unknown"
-
-
 def environment(args: argparse.Namespace) -> dict:
     commit = cmd_out(["git", "rev-parse", "HEAD"], cwd=args.root) or "unknown"
     dirty = bool(cmd_out(["git", "status", "--porcelain", "--untracked-files=no"], cwd=args.root))
@@ -106,7 +77,7 @@ def environment(args: argparse.Namespace) -> dict:
         "cpu_model": cpu_model(),
         "cores": os.cpu_count(),
         "cores_usable": affinity,
-        "loadavg_at_start": _loadavg(),
+        "loadavg_at_start": loadavg(),
         "python": platform.python_version(),
         "highway_env": md.version("highway-env"),
         "gymnasium": md.version("gymnasium"),

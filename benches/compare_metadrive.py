@@ -70,6 +70,8 @@ import sys
 import tempfile
 import time
 
+from bench_common import cmd_out, cpu_model, loadavg, log
+
 
 def parse_args() -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -91,37 +93,6 @@ def parse_args() -> argparse.Namespace:
     if min(a.reps, a.vehicles, a.sweep_runs, a.threads, a.md_episodes, a.md_max_steps) < 1:
         p.error("--reps, --vehicles, --sweep-runs, --threads, --md-episodes, --md-max-steps must be >= 1")
     return a
-
-
-def log(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
-
-
-def cmd_out(cmd: list[str], cwd: str | None = None) -> str:
-    try:
-        return subprocess.run(cmd, cwd=cwd, check=True, capture_output=True, text=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return ""
-
-
-def cpu_model() -> str:
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as f:
-            for line in f:
-                key, _, val = line.partition(":")
-                if key.strip() in ("model name", "Model", "Hardware", "cpu model"):
-                    return val.strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
-
-
-def loadavg() -> str:
-    try:
-        with open("/proc/loadavg", encoding="utf-8") as f:
-            return " ".join(f.read().split()[:3])
-    except OSError:
-        return "unknown"
 
 
 def version(name: str) -> str:
