@@ -2,6 +2,8 @@
 what the machine is (CPU model, load average), for the provenance each script reports."""
 from __future__ import annotations
 
+import datetime as _dt
+import os
 import platform
 import subprocess
 import sys
@@ -40,3 +42,34 @@ def loadavg() -> str:
             return " ".join(f.read().split()[:3])
     except OSError:
         return "unknown"
+
+
+def provenance(root: str, binary: str, packages: dict) -> dict:
+    """The run's provenance: date, machine, cores, load at start, Python, the peer's `packages`
+    (name -> version), the mergesim commit (and whether the tree is dirty) and the binary's
+    version and build time."""
+    commit = cmd_out(["git", "rev-parse", "HEAD"], cwd=root) or "unknown"
+    dirty = bool(cmd_out(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root))
+    try:
+        built = _dt.datetime.fromtimestamp(os.path.getmtime(binary), _dt.timezone.utc)
+        built_s = built.strftime("%Y-%m-%d %H:%M:%S UTC")
+    except OSError:
+        built_s = "unknown"
+    try:
+        usable = len(os.sched_getaffinity(0))
+    except AttributeError:
+        usable = None
+    return {
+        "date": cmd_out(["date", "-u"]) or _dt.datetime.now(_dt.timezone.utc).isoformat(),
+        "machine": cmd_out(["uname", "-m"]) or platform.machine(),
+        "cpu_model": cpu_model(),
+        "cores": os.cpu_count(),
+        "cores_usable": usable,
+        "loadavg_at_start": loadavg(),
+        "python": platform.python_version(),
+        **packages,
+        "mergesim_commit": commit,
+        "mergesim_tree_dirty": dirty,
+        "merge_sim_version": cmd_out([binary, "--version"]),
+        "merge_sim_binary_mtime": built_s,
+    }

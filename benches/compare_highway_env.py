@@ -23,11 +23,9 @@ raw samples.
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import importlib.metadata as md
 import json
 import os
-import platform
 import resource
 import statistics
 import subprocess
@@ -36,7 +34,7 @@ import tempfile
 import time
 import warnings
 
-from bench_common import cmd_out, cpu_model, loadavg, log
+from bench_common import loadavg, log, provenance
 
 
 def parse_args() -> argparse.Namespace:
@@ -60,33 +58,11 @@ def parse_args() -> argparse.Namespace:
 
 
 def environment(args: argparse.Namespace) -> dict:
-    commit = cmd_out(["git", "rev-parse", "HEAD"], cwd=args.root) or "unknown"
-    dirty = bool(cmd_out(["git", "status", "--porcelain", "--untracked-files=no"], cwd=args.root))
-    try:
-        bin_mtime = _dt.datetime.fromtimestamp(os.path.getmtime(args.bin), _dt.timezone.utc)
-        bin_mtime_s = bin_mtime.strftime("%Y-%m-%d %H:%M:%S UTC")
-    except OSError:
-        bin_mtime_s = "unknown"
-    try:
-        affinity = len(os.sched_getaffinity(0))
-    except AttributeError:
-        affinity = None
-    return {
-        "date": cmd_out(["date", "-u"]) or _dt.datetime.now(_dt.timezone.utc).isoformat(),
-        "machine": cmd_out(["uname", "-m"]) or platform.machine(),
-        "cpu_model": cpu_model(),
-        "cores": os.cpu_count(),
-        "cores_usable": affinity,
-        "loadavg_at_start": loadavg(),
-        "python": platform.python_version(),
+    return provenance(args.root, args.bin, {
         "highway_env": md.version("highway-env"),
         "gymnasium": md.version("gymnasium"),
         "numpy": md.version("numpy"),
-        "mergesim_commit": commit,
-        "mergesim_tree_dirty": dirty,
-        "merge_sim_version": cmd_out([args.bin, "--version"]),
-        "merge_sim_binary_mtime": bin_mtime_s,
-    }
+    })
 
 
 class HighwayEnvMerge:

@@ -57,12 +57,10 @@ to stderr); --json writes all raw samples.
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import importlib.metadata as md
 import json
 import logging
 import os
-import platform
 import resource
 import statistics
 import subprocess
@@ -70,7 +68,7 @@ import sys
 import tempfile
 import time
 
-from bench_common import cmd_out, cpu_model, loadavg, log
+from bench_common import loadavg, log, provenance
 
 
 def parse_args() -> argparse.Namespace:
@@ -103,35 +101,14 @@ def version(name: str) -> str:
 
 
 def environment(args: argparse.Namespace) -> dict:
-    commit = cmd_out(["git", "rev-parse", "HEAD"], cwd=args.root) or "unknown"
-    dirty = bool(cmd_out(["git", "status", "--porcelain", "--untracked-files=no"], cwd=args.root))
-    try:
-        mtime = _dt.datetime.fromtimestamp(os.path.getmtime(args.bin), _dt.timezone.utc)
-        bin_mtime = mtime.strftime("%Y-%m-%d %H:%M:%S UTC")
-    except OSError:
-        bin_mtime = "unknown"
-    try:
-        usable = len(os.sched_getaffinity(0))
-    except AttributeError:
-        usable = None
-    return {
-        "date": cmd_out(["date", "-u"]) or _dt.datetime.now(_dt.timezone.utc).isoformat(),
-        "machine": cmd_out(["uname", "-m"]) or platform.machine(),
-        "cpu_model": cpu_model(),
-        "cores": os.cpu_count(),
-        "cores_usable": usable,
-        "loadavg_at_start": loadavg(),
-        "python": platform.python_version(),
+    env = provenance(args.root, args.bin, {
         "metadrive_simulator": version("metadrive-simulator"),
         "panda3d": version("panda3d"),
         "gymnasium": version("gymnasium"),
         "numpy": version("numpy"),
-        "mergesim_commit": commit,
-        "mergesim_tree_dirty": dirty,
-        "merge_sim": os.path.abspath(args.bin),
-        "merge_sim_version": cmd_out([args.bin, "--version"]),
-        "merge_sim_binary_mtime": bin_mtime,
-    }
+    })
+    env["merge_sim"] = os.path.abspath(args.bin)
+    return env
 
 
 class MetaDrive:
