@@ -9,7 +9,7 @@ use crate::kinematic_body::KinematicBox;
 use crate::kinematics::Kinematics;
 use crate::params::VehicleParams;
 use crate::physics_world::PhysicsWorld;
-use crate::vehicle::{BodyBox, MU_RANGE, SPAWN_PROBE_HEIGHT_M};
+use crate::vehicle::{BodyBox, MU_RANGE, spawn_ground_height_m};
 use crate::vehicle_model::VehicleModel;
 
 mod car_params;
@@ -110,26 +110,7 @@ impl CommonRoadVehicle {
     ) -> Result<Self, VehicleError> {
         params.validate()?;
         integration.validate()?;
-        let [x_m, y_m, yaw_rad] = pose_m;
-        for (name, value) in [("x_m", x_m), ("y_m", y_m), ("yaw_rad", yaw_rad)] {
-            if !value.is_finite() {
-                return Err(VehicleError::invalid(
-                    format!("spawn.{name}"),
-                    value,
-                    "must be finite",
-                ));
-            }
-        }
-        if !speed_mps.is_finite() || speed_mps < 0.0 {
-            return Err(VehicleError::invalid(
-                "spawn.speed_mps",
-                speed_mps,
-                "must be finite and >= 0",
-            ));
-        }
-        let ground_z_m = world
-            .ground_height_m(x_m, y_m, SPAWN_PROBE_HEIGHT_M)
-            .ok_or(VehicleError::NoGround { x_m, y_m })?;
+        let ground_z_m = spawn_ground_height_m(world, pose_m, speed_mps)?;
         let mu = 1.0;
         let model_params = CommonRoadVehicleParams::from_vehicle_params(params, model, mu);
         model_params.validate()?;

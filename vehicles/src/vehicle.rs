@@ -29,7 +29,7 @@ use crate::wheel::{
 pub const MU_RANGE: (f64, f64) = (0.01, 3.0);
 
 /// Height above the spawn point from which the ground is searched (m).
-pub(crate) const SPAWN_PROBE_HEIGHT_M: f64 = 50.0;
+const SPAWN_PROBE_HEIGHT_M: f64 = 50.0;
 
 /// Below this horizontal speed the sideslip angle is reported as 0 (m/s).
 const SIDESLIP_MIN_SPEED_MPS: f64 = 0.1;
@@ -61,6 +61,36 @@ impl BodyBox {
             ],
         }
     }
+}
+
+/// The road's height below a spawn pose (x, y, heading; road coordinates), after checking the
+/// pose is finite and `speed_mps` finite and ≥ 0; errors name the field (`spawn.x_m`, …) or
+/// say there is no road below.
+pub(crate) fn spawn_ground_height_m(
+    world: &mut PhysicsWorld,
+    pose_m: [f64; 3],
+    speed_mps: f64,
+) -> Result<f64, VehicleError> {
+    let [x_m, y_m, yaw_rad] = pose_m;
+    for (name, value) in [("x_m", x_m), ("y_m", y_m), ("yaw_rad", yaw_rad)] {
+        if !value.is_finite() {
+            return Err(VehicleError::invalid(
+                format!("spawn.{name}"),
+                value,
+                "must be finite",
+            ));
+        }
+    }
+    if !speed_mps.is_finite() || speed_mps < 0.0 {
+        return Err(VehicleError::invalid(
+            "spawn.speed_mps",
+            speed_mps,
+            "must be finite and >= 0",
+        ));
+    }
+    world
+        .ground_height_m(x_m, y_m, SPAWN_PROBE_HEIGHT_M)
+        .ok_or(VehicleError::NoGround { x_m, y_m })
 }
 
 /// A simulated car.
@@ -155,25 +185,7 @@ impl Vehicle {
         speed_mps: f64,
     ) -> Result<Vehicle, VehicleError> {
         params.validate()?;
-        for (name, value) in [("x_m", x_m), ("y_m", y_m), ("yaw_rad", yaw_rad)] {
-            if !value.is_finite() {
-                return Err(VehicleError::invalid(
-                    format!("spawn.{name}"),
-                    value,
-                    "must be finite",
-                ));
-            }
-        }
-        if !speed_mps.is_finite() || speed_mps < 0.0 {
-            return Err(VehicleError::invalid(
-                "spawn.speed_mps",
-                speed_mps,
-                "must be finite and >= 0",
-            ));
-        }
-        let ground_z = world
-            .ground_height_m(x_m, y_m, SPAWN_PROBE_HEIGHT_M)
-            .ok_or(VehicleError::NoGround { x_m, y_m })?;
+        let ground_z = spawn_ground_height_m(world, [x_m, y_m, yaw_rad], speed_mps)?;
         // Rapier's coordinates are relative to the world's local origin.
         let [x_local_m, y_local_m] = world.to_local_m([x_m, y_m]);
 
