@@ -3,7 +3,7 @@
 //! is tracking, and the lane it is in (lane changes are events).
 
 use mergesim_types::lanes::{LaneId, LaneRoad};
-use mergesim_types::{Behaviour, PathPoint, VehicleId, VehicleShape};
+use mergesim_types::{Behaviour, PathPoint, VehicleId, VehicleShape, planning_brake_decel_mps2};
 use vehicles::tracker::Tracker;
 use vehicles::{VehicleModel, VehicleParams};
 
@@ -174,7 +174,12 @@ impl Agent {
                 spec,
             },
         )?;
-        let shape = vehicle.shape(VehicleShape::default().max_brake_decel_mps2);
+        // a_b of Eq. 5: this car's own braking limit on this road, with the margin
+        // (docs/vehicle_models.md, "The braking the planners rely on").
+        let shape = vehicle.shape(planning_brake_decel_mps2(
+            vehicle.braking_limit_mps2(config.mu),
+            config.planner_brake_margin,
+        ));
         let behaviour = behaviour_of(config, spec, registry, planner_override, lanes)?;
         let tracker = Tracker::new(config.tracker.clone(), &params);
         Ok(Self {

@@ -35,6 +35,11 @@ pub struct SimConfig {
     pub lane_road: Option<LaneRoadConfig>,
     /// Tire–road friction coefficient μ.
     pub mu: f64,
+    /// The share of its car's braking limit on this road (min(μ·g, its brakes')) that a
+    /// planner relies on, as a_b of Eq. 5, rounded down to 0.1 m/s²
+    /// (`mergesim_types::planning_brake_decel_mps2`; docs/vehicle_models.md). 0.9: 7 m/s² for
+    /// the presets at μ = 0.8.
+    pub planner_brake_margin: f64,
     /// What moves every car without its own `vehicle_model` (`crate::vehicle_models`):
     /// `rapier` (the default: rigid body on ray-cast wheels), `ks`, `st` or `std` (CommonRoad's
     /// models), or a registered model of one's own.
@@ -86,6 +91,7 @@ impl Default for SimConfig {
             road: MergeRoad::default(),
             lane_road: None,
             mu: 0.8,
+            planner_brake_margin: 0.9,
             vehicle_model: crate::vehicle_models::DEFAULT_VEHICLE_MODEL.to_string(),
             dt_s: 0.002,
             duration_s: 25.0,
@@ -109,6 +115,7 @@ impl Default for SimConfig {
 /// be at least one physics step.
 pub const SIM_BOUNDS: &[Bound] = &[
     Bound::above("mu", 0.0, 2.0, ""),
+    Bound::above("planner_brake_margin", 0.0, 1.0, ""),
     Bound::closed("dt_s", 1e-4, 0.02, "s"),
     Bound::above("duration_s", 0.0, 3600.0, "s"),
     Bound::closed("planner_period_s", 1e-4, 10.0, "s"),
@@ -173,6 +180,7 @@ impl SimConfig {
             SIM_BOUNDS,
             &[
                 ("mu", self.mu),
+                ("planner_brake_margin", self.planner_brake_margin),
                 ("dt_s", self.dt_s),
                 ("duration_s", self.duration_s),
                 ("planner_period_s", self.planner_period_s),

@@ -146,6 +146,7 @@ impl World {
             &config.recorded_traffic,
             &simulated_names,
             &config.idm,
+            (config.mu, config.planner_brake_margin),
             &mut physics,
         )?;
         let bus = V2vBus::new(

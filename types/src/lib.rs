@@ -43,4 +43,4 @@ pub use error::InvalidParameter;
 pub use grid::{GridSpec, MAX_GRID_CELLS};
 pub use path::{PathPoint, SharedLocalPath, TimedWaypoint};
 pub use road::{Lane, MERGE_SECTION_LENGTH_M, MergeRoad, ROAD_BOUNDS};
-pub use vehicle::{Neighbour, VehicleId, VehicleShape, VehicleState};
+pub use vehicle::{Neighbour, VehicleId, VehicleShape, VehicleState, planning_brake_decel_mps2};

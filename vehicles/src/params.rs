@@ -301,6 +301,14 @@ impl VehicleParams {
         self.mass_kg * gravity_mps2 * self.cog_to_front_axle_m / (2.0 * self.wheelbase_m())
     }
 
+    /// The largest braking deceleration the car can reach on a road of friction `mu` (m/s²):
+    /// min(μ·g, the brakes' torque limit / (R_w·m)). The tyre's peak is μ in every vehicle
+    /// model (docs/vehicle_models.md, "The braking the planners rely on").
+    pub fn braking_limit_mps2(&self, mu: f64) -> f64 {
+        let brakes_mps2 = self.max_brake_torque_nm / (self.wheel_radius_m * self.mass_kg);
+        (mu * crate::physics_world::GRAVITY_MPS2).min(brakes_mps2)
+    }
+
     /// Largest drive torque on one wheel (N·m), index in FL, FR, RL, RR order.
     pub fn max_drive_torque_wheel_nm(&self, wheel: usize) -> f64 {
         let share = if wheel < 2 {
@@ -429,6 +437,16 @@ impl VehicleParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn braking_limit_is_friction_or_brakes_whichever_is_less() {
+        for p in [VehicleParams::default(), crate::presets::vw_vanagon()] {
+            let brakes = p.max_brake_torque_nm / (p.wheel_radius_m * p.mass_kg);
+            assert!((brakes - 11.5).abs() < 1e-9, "{brakes}");
+            assert!((p.braking_limit_mps2(0.8) - 0.8 * 9.81).abs() < 1e-12);
+            assert!((p.braking_limit_mps2(1.5) - 11.5).abs() < 1e-9);
+        }
+    }
 
     #[test]
     fn partial_config_fills_defaults_and_unknown_fields_are_rejected() {

@@ -33,6 +33,13 @@ pub trait VehicleModel: Send + Sync {
     /// see.
     fn body_box(&self) -> BodyBox;
 
+    /// The largest braking deceleration this car can reach on a road of friction `mu` (m/s²);
+    /// by default its parameters' [`VehicleParams::braking_limit_mps2`]. The simulator gives
+    /// the planners a margin below it (`mergesim_types::planning_brake_decel_mps2`).
+    fn braking_limit_mps2(&self, mu: f64) -> f64 {
+        self.params().braking_limit_mps2(mu)
+    }
+
     /// The planner's footprint of this car, braking at `max_brake_decel_mps2` (m/s²).
     fn shape(&self, max_brake_decel_mps2: f64) -> mergesim_types::VehicleShape {
         let p = self.params();

@@ -46,8 +46,8 @@
 //! own trajectory is in its source file).
 
 use mergesim_types::lanes::{LaneId, LaneRoad};
-use mergesim_types::{Neighbour, VehicleId, VehicleShape, VehicleState};
-use vehicles::{KinematicBox, PhysicsWorld, VehicleParams};
+use mergesim_types::{Neighbour, VehicleId, VehicleShape, VehicleState, planning_brake_decel_mps2};
+use vehicles::{GRAVITY_MPS2, KinematicBox, PhysicsWorld, VehicleParams};
 
 use crate::body_state::BodyState;
 use crate::error::SimError;
@@ -114,6 +114,7 @@ impl RecordedFleet {
         traffic: &RecordedTraffic,
         simulated_names: &[String],
         idm: &IdmParams,
+        (mu, planner_brake_margin): (f64, f64),
         physics: &mut PhysicsWorld,
     ) -> Result<Self, SimError> {
         traffic.validate(simulated_names)?;
@@ -135,7 +136,10 @@ impl RecordedFleet {
                 length_m: vehicle.length_m,
                 width_m: vehicle.width_m,
                 wheelbase_m: wheelbase_m.min(vehicle.length_m),
-                max_brake_decel_mps2: VehicleShape::default().max_brake_decel_mps2,
+                max_brake_decel_mps2: planning_brake_decel_mps2(
+                    mu * GRAVITY_MPS2,
+                    planner_brake_margin,
+                ),
             };
             let mut member = Member {
                 id: first_id + k as VehicleId,
