@@ -86,6 +86,13 @@ impl SafetyMonitor {
                 let Some((a, b)) = clip_segment_near(centre, radius_m, segment.a, segment.b) else {
                     continue;
                 };
+                // No parry query where the box is, with a margin, farther from the segment's
+                // line than the contact tolerance: the outcome is "no contact" either way.
+                if box_line_gap_lower_bound_m(body, a, b)
+                    > self.params.contact_tolerance_m + LINE_CULL_MARGIN_M
+                {
+                    continue;
+                }
                 let shape = Segment::new(
                     Vector::new((a[0] - body.x_m) as f32, (a[1] - body.y_m) as f32, z_mid),
                     Vector::new((b[0] - body.x_m) as f32, (b[1] - body.y_m) as f32, z_mid),
@@ -152,6 +159,29 @@ fn clip_segment_near(
     })
 }
 
+/// Margin (m) by which the box must clear an edge's line before the exact query is skipped:
+/// far above parry's f32 error at a box's scale (micrometres), far below any contact tolerance
+/// that matters, so skipping never changes an outcome.
+const LINE_CULL_MARGIN_M: f64 = 1e-3;
+
+/// A lower bound of the distance (m) from the body's box (in the road plane) to the segment
+/// `a`–`b`: its distance to the segment's line, |n·(c − a)| minus the box's half-extent along
+/// the line's normal n, at least 0. For a degenerate segment, 0 (no bound).
+fn box_line_gap_lower_bound_m(body: &BodyState, a: [f64; 2], b: [f64; 2]) -> f64 {
+    let ab = [b[0] - a[0], b[1] - a[1]];
+    let length_m = ab[0].hypot(ab[1]);
+    if length_m <= 0.0 {
+        return 0.0;
+    }
+    let n = [-ab[1] / length_m, ab[0] / length_m];
+    let (sin_yaw, cos_yaw) = body.yaw_rad.sin_cos();
+    // Half-extent of the box along n: half-length · |n·heading| + half-width · |n·left|.
+    let extent_m = 0.5 * body.length_m * (n[0] * cos_yaw + n[1] * sin_yaw).abs()
+        + 0.5 * body.width_m * (-n[0] * sin_yaw + n[1] * cos_yaw).abs();
+    let centre_m = (n[0] * (body.x_m - a[0]) + n[1] * (body.y_m - a[1])).abs();
+    (centre_m - extent_m).max(0.0)
+}
+
 /// Euclidean distance from point `p` to the segment `a`–`b` (closed form).
 fn point_segment_distance_m(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let ab = [b[0] - a[0], b[1] - a[1]];
@@ -177,6 +207,44 @@ mod tests {
         assert!((point_segment_distance_m([7.0, 4.0], [0.0, 0.0], [4.0, 0.0]) - 5.0).abs() < 1e-12);
         // Degenerate segment.
         assert!((point_segment_distance_m([3.0, 4.0], [0.0, 0.0], [0.0, 0.0]) - 5.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn box_line_bound_is_the_gap_to_the_line() {
+        let body = |x_m: f64, y_m: f64, yaw_rad: f64| BodyState {
+            id: 0,
+            x_m,
+            y_m,
+            yaw_rad,
+            vx_mps: 0.0,
+            vy_mps: 0.0,
+            yaw_rate_radps: 0.0,
+            length_m: 4.0,
+            width_m: 2.0,
+            height_m: 1.5,
+        };
+        // Along the line, 3 m from it: 3 − 1 (half-width).
+        let lb = box_line_gap_lower_bound_m(&body(0.0, 3.0, 0.0), [-10.0, 0.0], [10.0, 0.0]);
+        assert!((lb - 2.0).abs() < 1e-12, "{lb}");
+        // Across it: 3 − 2 (half-length); the side it lies on does not matter.
+        let lb = box_line_gap_lower_bound_m(
+            &body(0.0, -3.0, std::f64::consts::FRAC_PI_2),
+            [-10.0, 0.0],
+            [10.0, 0.0],
+        );
+        assert!((lb - 1.0).abs() < 1e-12, "{lb}");
+        // Turned by 45°: the corner reaches (2 + 1)/√2 towards the line.
+        let lb = box_line_gap_lower_bound_m(
+            &body(0.0, 3.0, std::f64::consts::FRAC_PI_4),
+            [-10.0, 0.0],
+            [10.0, 0.0],
+        );
+        assert!((lb - (3.0 - 3.0 / 2f64.sqrt())).abs() < 1e-12, "{lb}");
+        // Touching or crossing: 0.
+        assert_eq!(
+            box_line_gap_lower_bound_m(&body(0.0, 0.5, 0.0), [-10.0, 0.0], [10.0, 0.0]),
+            0.0
+        );
     }
 
     #[test]

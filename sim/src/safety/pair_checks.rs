@@ -84,7 +84,10 @@ impl SafetyMonitor {
         let current_min_gap_m = state.map_or(f64::INFINITY, |s| s.min_gap_m);
         let (gap_m, gap_is_lower_bound) = if overlapping {
             (0.0, false)
-        } else if gap_lower_bound_m < current_min_gap_m || gap_lower_bound_m <= tolerance_m {
+        } else if (gap_lower_bound_m < current_min_gap_m
+            && centre_axis_gap_lower_bound_m(a, b) <= current_min_gap_m + AXIS_CULL_MARGIN_M)
+            || gap_lower_bound_m <= tolerance_m
+        {
             let [(pose_a, box_a), (pose_b, box_b)] = boxes.get();
             let d = query::distance(&pose_a, &box_a, &pose_b, &box_b)
                 .map_err(|e| SafetyError::Unsupported(format!("{e:?}")))?
@@ -199,6 +202,32 @@ impl SafetyMonitor {
     }
 }
 
+/// Margin (m) by which the boxes must clear the pair's smallest gap so far before the exact
+/// gap query is skipped: far above parry's f32 error at a box's scale (micrometres), so a
+/// skipped query could not have lowered that gap, and no result changes.
+const AXIS_CULL_MARGIN_M: f64 = 1e-4;
+
+/// A lower bound of the gap (m) between the footprints of `a` and `b`: their separation along
+/// the line through their centres (a separating-axis bound), the centre distance less each
+/// box's half-extent along it, at least 0. Tighter than the bounding circles' for cars in
+/// line (exact for two aligned boxes one behind the other), so a pair following at a steady
+/// gap needs no exact query at every instant. Both boxes rest on the road plane, so their
+/// gap in 3-D is their footprints' gap.
+fn centre_axis_gap_lower_bound_m(a: &BodyState, b: &BodyState) -> f64 {
+    let d = [b.x_m - a.x_m, b.y_m - a.y_m];
+    let distance_m = d[0].hypot(d[1]);
+    if distance_m <= 0.0 {
+        return 0.0;
+    }
+    let u = [d[0] / distance_m, d[1] / distance_m];
+    let half_extent_m = |body: &BodyState| {
+        let (sin_yaw, cos_yaw) = body.yaw_rad.sin_cos();
+        0.5 * body.length_m * (u[0] * cos_yaw + u[1] * sin_yaw).abs()
+            + 0.5 * body.width_m * (-u[0] * sin_yaw + u[1] * cos_yaw).abs()
+    };
+    (distance_m - half_extent_m(a) - half_extent_m(b)).max(0.0)
+}
+
 /// The body's cuboid and its pose relative to the origin (`origin_x_m`, `origin_y_m`, 0):
 /// resting on the road plane, rotated by the yaw about +Z.
 pub(super) fn local_box(body: &BodyState, origin_x_m: f64, origin_y_m: f64) -> (Pose, Cuboid) {
@@ -216,4 +245,57 @@ pub(super) fn local_box(body: &BodyState, origin_x_m: f64, origin_y_m: f64) -> (
         Vector::new(0.0, 0.0, body.yaw_rad as f32),
     );
     (pose, Cuboid::new(half))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn body(x_m: f64, y_m: f64, yaw_rad: f64) -> BodyState {
+        BodyState {
+            id: 0,
+            x_m,
+            y_m,
+            yaw_rad,
+            vx_mps: 0.0,
+            vy_mps: 0.0,
+            yaw_rate_radps: 0.0,
+            length_m: 4.0,
+            width_m: 2.0,
+            height_m: 1.5,
+        }
+    }
+
+    /// parry's exact gap of the two boxes.
+    fn exact_gap_m(a: &BodyState, b: &BodyState) -> f64 {
+        let (pa, ba) = local_box(a, 0.0, 0.0);
+        let (pb, bb) = local_box(b, 0.0, 0.0);
+        f64::from(query::distance(&pa, &ba, &pb, &bb).unwrap().distance)
+    }
+
+    #[test]
+    fn centre_axis_bound_is_exact_in_line_and_never_above_the_gap() {
+        // One behind the other, aligned: 10 − 2 − 2.
+        let lb = centre_axis_gap_lower_bound_m(&body(0.0, 0.0, 0.0), &body(10.0, 0.0, 0.0));
+        assert!((lb - 6.0).abs() < 1e-12, "{lb}");
+        assert!((exact_gap_m(&body(0.0, 0.0, 0.0), &body(10.0, 0.0, 0.0)) - 6.0).abs() < 1e-5);
+        // Overlapping: 0.
+        assert_eq!(
+            centre_axis_gap_lower_bound_m(&body(0.0, 0.0, 0.0), &body(3.0, 0.5, 0.3)),
+            0.0
+        );
+        // Any placement: at most the exact gap (parry's f32 within 1e-5 m).
+        for k in 0..400 {
+            let t = k as f64;
+            let a = body(0.0, 0.0, 0.37 * t);
+            let b = body(
+                6.0 * (0.11 * t).cos() + 0.5,
+                7.0 * (0.07 * t).sin(),
+                0.91 * t,
+            );
+            let lb = centre_axis_gap_lower_bound_m(&a, &b);
+            let gap = exact_gap_m(&a, &b);
+            assert!(lb <= gap + 1e-5, "{k}: bound {lb} above the gap {gap}");
+        }
+    }
 }
