@@ -23,6 +23,7 @@ raw samples.
 from __future__ import annotations
 
 import argparse
+import re
 import importlib.metadata as md
 import json
 import os
@@ -46,6 +47,9 @@ def parse_args() -> argparse.Namespace:
     p.add_argument("--planner", default=None)
     p.add_argument("--vehicle-model", default=None,
                    help="vehicle model of every mergesim car (merge_sim run --vehicle-model)")
+    p.add_argument("--dt-s", default=None,
+                   help="comma-separated physics steps (s): one mergesim row (and PF-CS row) per value, "
+                        "each from a copy of the scenario with [sim] dt_s replaced; default: the scenario's own")
     p.add_argument("--hwe-episodes", type=int, default=10)
     p.add_argument("--hwe-seed", type=int, default=0)
     p.add_argument("--hwe-max-policy-steps", type=int, default=1000,
@@ -156,13 +160,43 @@ class HighwayEnvMerge:
         }
 
 
+def scenario_with_dt(bin_path: str, scenario: str, dt_s: float, path: str) -> str:
+    """Writes the scenario (a TOML file, or a built-in by `merge_sim scenario show`) to `path`
+    with its `[sim]` table's dt_s set to `dt_s`; returns `path`."""
+    if os.path.isfile(scenario):
+        with open(scenario, encoding="utf-8") as f:
+            text = f.read()
+    else:
+        proc = subprocess.run([bin_path, "scenario", "show", scenario], capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise SystemExit(f"merge_sim scenario show {scenario} failed: {proc.stderr}")
+        text = proc.stdout
+    sim = re.search(r"^\[sim\]\s*$", text, flags=re.M)
+    if sim is None:
+        raise SystemExit(f"{scenario}: no [sim] table to set dt_s in")
+    head, body = text[: sim.end()], text[sim.end():]
+    table_end = re.search(r"^\[", body, flags=re.M)
+    table, rest = (body[: table_end.start()], body[table_end.start():]) if table_end else (body, "")
+    table, n = re.subn(r"^dt_s\s*=.*$", f"dt_s = {dt_s!r}", table, count=1, flags=re.M)
+    if n == 0:
+        table = f"\ndt_s = {dt_s!r}" + table
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(head + table + rest)
+    return path
+
+
 class MergeSim:
-    def __init__(self, args: argparse.Namespace, planner: str | None, tmp: str, tag: str) -> None:
+    def __init__(self, args: argparse.Namespace, planner: str | None, tmp: str, tag: str,
+                 dt_s: float | None = None) -> None:
         self.bin = args.bin
         self.scenario = args.scenario
         self.planner = planner
+        self.dt_s = dt_s
         self.out = os.path.join(tmp, f"{tag}.json")
-        self.cmd = [self.bin, "run", "--scenario", self.scenario, "--no-rrd", "--json", self.out, "--quiet"]
+        source = self.scenario
+        if dt_s is not None:
+            source = scenario_with_dt(self.bin, self.scenario, dt_s, os.path.join(tmp, f"{tag}.toml"))
+        self.cmd = [self.bin, "run", "--scenario", source, "--no-rrd", "--json", self.out, "--quiet"]
         if planner:
             self.cmd += ["--planner", planner]
         self.vehicle_model = args.vehicle_model
@@ -171,7 +205,9 @@ class MergeSim:
         self.label = f"mergesim {self.scenario} ({planner or 'scenario default'}{self._model()})"
 
     def _model(self) -> str:
-        return f", {self.vehicle_model} vehicles" if self.vehicle_model else ""
+        model = f", {self.vehicle_model} vehicles" if self.vehicle_model else ""
+        step = f", dt {self.dt_s * 1e3:g} ms" if self.dt_s is not None else ""
+        return model + step
 
     def run(self) -> dict:
         if os.path.exists(self.out):
@@ -233,17 +269,27 @@ def main() -> int:
     hwe = HighwayEnvMerge(args)
     tmp = tempfile.mkdtemp(prefix="mergesim-cmp-")
     try:
-        variants: list = [("hwe", hwe), ("ms", MergeSim(args, args.planner, tmp, "ms"))]
-        if args.planner != "pf-cs":
-            variants.append(("ms_pf_cs", MergeSim(args, "pf-cs", tmp, "ms_pf_cs")))
+        steps = [float(x) for x in args.dt_s.split(",")] if args.dt_s else [None]
+        variants: list = [("hwe", hwe)]
+        for k, dt_s in enumerate(steps):
+            suffix = "" if dt_s is None else f"_dt{k}"
+            main_variant = MergeSim(args, args.planner, tmp, f"ms{suffix}", dt_s)
+            variants.append((f"ms{suffix}", main_variant))
+            if args.planner != "pf-cs":
+                variants.append((f"ms_pf_cs{suffix}", MergeSim(args, "pf-cs", tmp, f"ms_pf_cs{suffix}", dt_s)))
 
         log("warm-up (untimed): one highway-env episode and one run of each mergesim variant")
         hwe.run(episodes=1, seed0=args.hwe_seed + 10_000)
         for key, v in variants[1:]:
             v.run()
-        # The default-planner variant may have resolved to pf-cs itself: drop the duplicate.
-        if len(variants) == 3 and variants[1][1].label == variants[2][1].label:
-            variants.pop()
+        # A default-planner variant may have resolved to pf-cs itself: drop the duplicate.
+        labels = set()
+        unique = []
+        for key, v in variants:
+            if v is hwe or v.label not in labels:
+                unique.append((key, v))
+                labels.add(getattr(v, "label", None))
+        variants = unique
 
         samples: dict[str, list[dict]] = {key: [] for key, _ in variants}
         for r in range(args.reps):
@@ -334,6 +380,7 @@ def main() -> int:
             "scenario": args.scenario,
             "planner": args.planner,
             "vehicle_model": args.vehicle_model,
+            "dt_s": args.dt_s,
             "variants": {key: {"label": v.label, "command": getattr(v, "cmd", None),
                                "summary": summ[key], "samples": samples[key]} for key, v in variants},
             "ratios_to_highway_env": {key: {"process": summ[key]["rate_median"] / base,

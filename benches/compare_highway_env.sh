@@ -40,7 +40,7 @@
 # merge_sim binary is built (`cargo build --release --bin merge_sim`) if missing, or always with
 # --build. Needs bash, python3 (with venv/ensurepip), pip access to PyPI, cargo.
 #
-# Usage: benches/compare_highway_env.sh [--reps N] [--scenario NAME] [--planner NAME] [--vehicle-model M]
+# Usage: benches/compare_highway_env.sh [--reps N] [--scenario NAME] [--planner NAME] [--vehicle-model M] [--dt-s DT,...]
 #                                       [--hwe-episodes N] [--json PATH] [--build] [--help]
 set -euo pipefail
 
@@ -62,6 +62,9 @@ Options:
                      default: the scenario's own, PF-ISO for urgent_merge)
   --vehicle-model M  vehicle model of every mergesim car (`merge_sim run --vehicle-model`:
                      rapier, the default, ks, st or std)
+  --dt-s DT[,DT...]  physics step(s) of the mergesim runs (s): one row per value (and its PF-CS
+                     row), each from a copy of the scenario with [sim] dt_s replaced (default: the
+                     scenario's own, 0.002 for the built-ins); e.g. 0.002,0.01 with ks vehicles
   --hwe-episodes N   highway-env episodes per repetition (default 10)
   --json PATH        also write all samples and the environment as JSON
   --build            run `cargo build --release --bin merge_sim` even if the binary exists
@@ -76,6 +79,7 @@ reps=5
 scenario=urgent_merge
 planner=""
 vehicle_model=""
+dt_s=""
 hwe_episodes=10
 json=""
 build=0
@@ -86,6 +90,7 @@ while [[ $# -gt 0 ]]; do
     --scenario) need "$@"; scenario=$2; shift 2 ;;
     --planner) need "$@"; planner=$2; shift 2 ;;
     --vehicle-model) need "$@"; vehicle_model=$2; shift 2 ;;
+    --dt-s) need "$@"; dt_s=$2; shift 2 ;;
     --hwe-episodes) need "$@"; hwe_episodes=$2; shift 2 ;;
     --json) need "$@"; json=$2; shift 2 ;;
     --build) build=1; shift ;;
@@ -124,5 +129,6 @@ fi
 args=(--bin "$bin" --root "$root" --reps "$reps" --scenario "$scenario" --hwe-episodes "$hwe_episodes")
 if [[ -n $planner ]]; then args+=(--planner "$planner"); fi
 if [[ -n $vehicle_model ]]; then args+=(--vehicle-model "$vehicle_model"); fi
+if [[ -n $dt_s ]]; then args+=(--dt-s "$dt_s"); fi
 if [[ -n $json ]]; then args+=(--json "$json"); fi
 exec "$py" "$root/benches/compare_highway_env.py" "${args[@]}"

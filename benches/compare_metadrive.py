@@ -31,6 +31,11 @@ and this is a throughput comparison, not a like-for-like one:
         in the Bullet world and stepped by it -- a second row, favourable to MetaDrive.
     Timed: env.reset() and env.step() calls only (env construction, imports and the counting
     done here between steps excluded); the steps-only time is the second column.
+    MetaDrive, N processes at once (--md-procs, default every core): the same, in N worker
+    processes of this script, each with its own env and the same episodes, told to start
+    together every repetition; the repetition's time is the slowest worker's own reset + step
+    time, its vehicle-seconds the workers' sum. It is the all-cores figure to set beside
+    mergesim's `sweep` (one MetaDrive process uses one core).
   * mergesim: the platoon of `platoon_merge_50` with --vehicles N cars (`merge_sim scenario
     platoon --vehicles N`, the scale scenarios of the README's scaling table; N = 10: 5 per lane
     at 20 m/s zipping into one lane, 72 s): Rapier rigid-body vehicles stepped at 500 Hz with
@@ -86,10 +91,15 @@ def parse_args() -> argparse.Namespace:
     p.add_argument("--md-traffic-density", type=float, default=None,
                    help="MetaDrive traffic_density (default: MetaDrive's own, 0.1)")
     p.add_argument("--md-max-steps", type=int, default=3000, help="safety cap of env.steps per episode")
+    p.add_argument("--md-procs", type=int, default=os.cpu_count() or 1,
+                   help="MetaDrive processes run at once for the all-cores row (default: every core; "
+                        "1 leaves the row out)")
+    p.add_argument("--md-worker", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--json", dest="json_path", default=None)
     a = p.parse_args()
-    if min(a.reps, a.vehicles, a.sweep_runs, a.threads, a.md_episodes, a.md_max_steps) < 1:
-        p.error("--reps, --vehicles, --sweep-runs, --threads, --md-episodes, --md-max-steps must be >= 1")
+    if min(a.reps, a.vehicles, a.sweep_runs, a.threads, a.md_episodes, a.md_max_steps, a.md_procs) < 1:
+        p.error("--reps, --vehicles, --sweep-runs, --threads, --md-episodes, --md-max-steps, --md-procs "
+                "must be >= 1")
     return a
 
 
@@ -225,6 +235,77 @@ class MetaDrive:
         self.env.close()
 
 
+def worker_main(args: argparse.Namespace) -> int:
+    """One MetaDrive process of the all-cores row: builds and warms up its env, says `ready`, then
+    runs one repetition per `go` line on stdin and answers with its sample as one JSON line."""
+    proto = os.fdopen(os.dup(1), "w", encoding="utf-8")
+    sys.stdout.flush()
+    os.dup2(2, 1)  # MetaDrive's own printing goes to stderr, the protocol to the real stdout
+    mdv = MetaDrive(args)
+    try:
+        mdv.warm_up()
+        print("ready", file=proto, flush=True)
+        for line in sys.stdin:
+            if line.strip() != "go":
+                break
+            print(json.dumps(mdv.run()), file=proto, flush=True)
+    finally:
+        mdv.close()
+    return 0
+
+
+class MetaDrivePool:
+    """--md-procs MetaDrive processes, each with its own env and the same episodes, started at
+    once every repetition: MetaDrive on every core (one process uses one). A repetition's wall
+    time is the slowest worker's own reset() + step() time (favourable to MetaDrive: start-up,
+    the pipe and the counting are excluded); its vehicle-seconds are the workers' sum."""
+
+    def __init__(self, args: argparse.Namespace) -> None:
+        cmd = [sys.executable, os.path.abspath(__file__), "--md-worker", "--bin", args.bin,
+               "--md-episodes", str(args.md_episodes), "--md-seed", str(args.md_seed),
+               "--md-max-steps", str(args.md_max_steps)]
+        if args.md_traffic_density is not None:
+            cmd += ["--md-traffic-density", str(args.md_traffic_density)]
+        self.cmd = cmd
+        self.procs = [subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+                      for _ in range(args.md_procs)]
+        self.label = f"MetaDrive, {args.md_procs} processes at once (driving vehicles)"
+
+    def warm_up(self) -> None:
+        for p in self.procs:
+            line = p.stdout.readline().strip()
+            if line != "ready":
+                raise SystemExit(f"MetaDrive worker failed to start: {line!r}")
+
+    def run(self) -> dict:
+        for p in self.procs:
+            p.stdin.write("go\n")
+            p.stdin.flush()
+        got = []
+        for p in self.procs:
+            line = p.stdout.readline()
+            if not line:
+                raise SystemExit("a MetaDrive worker died")
+            got.append(json.loads(line))
+        return {
+            "wall_s": max(g["wall_s"] for g in got),
+            "inner_wall_s": max(g["inner_wall_s"] for g in got),
+            "cpu_s": sum(g["cpu_s"] for g in got),
+            "vehicle_s": sum(g["vehicle_s"] for g in got),
+            "vehicle_s_all": sum(g["vehicle_s_all"] for g in got),
+            "sim_s": sum(g["sim_s"] for g in got),
+            "workers": got,
+        }
+
+    def close(self) -> None:
+        for p in self.procs:
+            try:
+                p.stdin.close()
+            except OSError:
+                pass
+            p.wait(timeout=60)
+
+
 class MergeSim:
     """One `merge_sim run` or `merge_sim sweep` process per repetition."""
 
@@ -308,6 +389,8 @@ def fmt(x: float) -> str:
 
 def main() -> int:
     args = parse_args()
+    if args.md_worker:
+        return worker_main(args)
     # Everything MetaDrive, Panda3D or pygame print goes to stderr; the table to the real stdout.
     out_fd = os.dup(1)
     sys.stdout.flush()
@@ -327,10 +410,13 @@ def main() -> int:
     log("creating the MetaDrive env (untimed) ...")
     mdv = MetaDrive(args)
     ms = [MergeSim(args.bin, scenario, os.path.join(tmp, f"{k}.json"), k, args) for k in ("run1", "run", "sweep")]
-    variants: list = [("md", mdv)] + [(m.kind, m) for m in ms]
+    pool = MetaDrivePool(args) if args.md_procs > 1 else None
+    variants: list = [("md", mdv)] + ([("md_pool", pool)] if pool else []) + [(m.kind, m) for m in ms]
     try:
         log("warm-up (untimed): every MetaDrive scenario's reset + one episode, one run of each mergesim variant")
         mdv.warm_up()
+        if pool:
+            pool.warm_up()
         first = ms[0].run()
         for m in ms:
             m.duration_s = first["sim_s"]
@@ -344,6 +430,8 @@ def main() -> int:
         md_config = mdv.config()
     finally:
         mdv.close()
+        if pool:
+            pool.close()
         for name in os.listdir(tmp):
             os.remove(os.path.join(tmp, name))
         os.rmdir(tmp)
@@ -392,6 +480,8 @@ def main() -> int:
     out.append("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     rows = [("md", mdv.label, f"1–{mds[0]['max_vehicles']} (mean {summ['md']['vehicle_s_per_rep'] / summ['md']['sim_s_per_rep']:.1f})"),
             ("md_all", mdv.label_all, f"≤ {mds[0]['max_vehicles_all']} (mean {summ['md_all']['vehicle_s_per_rep'] / summ['md_all']['sim_s_per_rep']:.1f})")]
+    if pool:
+        rows.append(("md_pool", pool.label, f"1–{mds[0]['max_vehicles']} per process"))
     rows += [(m.kind, m.label, "/".join(str(n) for n in samples[m.kind][0]["vehicles"])) for m in ms]
     for key, label, veh in rows:
         s = summ[key]
@@ -411,7 +501,12 @@ def main() -> int:
                "² mergesim: wall time of the whole merge_sim process, measured around the subprocess (start-up "
                "included). ³ MetaDrive: env.step() calls only. ⁴ mergesim: the JSON's in-process `wall_time_s`. "
                "Ratio = the row's median / MetaDrive's (driving vehicles) median, of the same column. "
-               "CPU / wall: 1.00 = one core busy; MetaDrive runs on one core.")
+               "CPU / wall: 1.00 = one core busy; one MetaDrive process runs on one core.")
+    if pool:
+        both = summ["sweep"]["rate_median"] / summ["md_pool"]["rate_median"]
+        out.append("")
+        out.append(f"Every core on both sides: mergesim `sweep` / MetaDrive {args.md_procs} processes = "
+                   f"{both:.2f} (medians of the main column).")
     print("\n".join(out), file=report, flush=True)
 
     if args.json_path:
@@ -421,7 +516,7 @@ def main() -> int:
             "metadrive_config": md_config,
             "args": vars(args),
             "variants": {k: {"label": v.label, "command": getattr(v, "cmd", None),
-                             "env": ({"RAYON_NUM_THREADS": v.env.get("RAYON_NUM_THREADS")} if k != "md" else None),
+                             "env": ({"RAYON_NUM_THREADS": v.env.get("RAYON_NUM_THREADS")} if isinstance(v, MergeSim) else None),
                              "summary": summ[k], "samples": samples[k]} for k, v in variants},
             "metadrive_all_vehicles_summary": summ["md_all"],
             "ratios_to_metadrive": {k: summ[k]["rate_median"] / base for k in summ if k != "md"},

@@ -31,7 +31,7 @@
 # Needs bash, python3 (with venv/ensurepip), pip access to PyPI (no other network access).
 #
 # Usage: benches/compare_metadrive.sh [--reps N] [--vehicles N] [--sweep-runs K] [--threads T]
-#                                     [--md-episodes N] [--json PATH] [--bin PATH] [--build] [--help]
+#                                     [--md-episodes N] [--md-procs P] [--json PATH] [--bin PATH] [--build] [--help]
 set -euo pipefail
 
 METADRIVE_PIN="metadrive-simulator==0.4.3"
@@ -54,6 +54,8 @@ Options:
   --sweep-runs K    instances per `merge_sim sweep` repetition (default 4)
   --threads T       worker threads of the sweep (default: every core)
   --md-episodes N   MetaDrive episodes per repetition (default 10, seeds 0..N-1)
+  --md-procs P      MetaDrive processes run at once for the all-cores row (default: every
+                    core; 1 leaves the row out)
   --json PATH       also write all samples and the environment as JSON
   --bin PATH        merge_sim binary to use (default target/release/merge_sim, built if missing)
   --build           run `cargo build --release --bin merge_sim` even if the binary exists
@@ -69,6 +71,7 @@ vehicles=10
 sweep_runs=4
 threads=""
 md_episodes=10
+md_procs=""
 json=""
 bin=""
 build=0
@@ -81,6 +84,7 @@ while [[ $# -gt 0 ]]; do
     --sweep-runs) need "$@"; posint "$1" "$2"; sweep_runs=$2; shift 2 ;;
     --threads) need "$@"; posint "$1" "$2"; threads=$2; shift 2 ;;
     --md-episodes) need "$@"; posint "$1" "$2"; md_episodes=$2; shift 2 ;;
+    --md-procs) need "$@"; posint "$1" "$2"; md_procs=$2; shift 2 ;;
     --json) need "$@"; json=$2; shift 2 ;;
     --bin) need "$@"; bin=$2; shift 2 ;;
     --build) build=1; shift ;;
@@ -143,5 +147,6 @@ PY
 args=(--bin "$bin" --root "$root" --reps "$reps" --vehicles "$vehicles" --sweep-runs "$sweep_runs"
       --md-episodes "$md_episodes")
 if [[ -n $threads ]]; then args+=(--threads "$threads"); fi
+if [[ -n $md_procs ]]; then args+=(--md-procs "$md_procs"); fi
 if [[ -n $json ]]; then args+=(--json "$json"); fi
 exec "$py" "$root/benches/compare_metadrive.py" "${args[@]}"
