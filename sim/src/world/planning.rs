@@ -94,28 +94,46 @@ impl World {
         };
         // 2. Every vehicle decides, in parallel: a decision depends only on its own behaviour
         // and observation, so the results are those of one thread, bit for bit.
+        let decide = |index: usize, agent: &mut Agent| {
+            let observation = observation_of(index, agent);
+            let started = Instant::now();
+            let decision =
+                agent
+                    .behaviour
+                    .plan(&observation)
+                    .map_err(|source| SimError::Behaviour {
+                        vehicle: agent.spec.name.clone(),
+                        source,
+                    });
+            (decision, started.elapsed().as_secs_f64() * 1e6)
+        };
+        // With fewer than two planners (IDM drivers, lane keepers: microseconds each) handing
+        // the decisions to the thread pool costs more than they do: they run here, in order.
+        let planners = self
+            .agents
+            .iter()
+            .filter(|a| a.behaviour.is_planner())
+            .take(2)
+            .count();
         let agents = &mut self.agents;
-        let mut decide_all =
-            move || -> Vec<(Result<Decision, SimError>, f64)> {
+        let decided: Vec<(Result<Decision, SimError>, f64)> = if planners < 2 {
+            agents
+                .iter_mut()
+                .enumerate()
+                .map(|(index, agent)| decide(index, agent))
+                .collect()
+        } else {
+            let mut decide_all = || -> Vec<(Result<Decision, SimError>, f64)> {
                 agents
                     .par_iter_mut()
                     .enumerate()
-                    .map(|(index, agent)| {
-                        let observation = observation_of(index, agent);
-                        let started = Instant::now();
-                        let decision = agent.behaviour.plan(&observation).map_err(|source| {
-                            SimError::Behaviour {
-                                vehicle: agent.spec.name.clone(),
-                                source,
-                            }
-                        });
-                        (decision, started.elapsed().as_secs_f64() * 1e6)
-                    })
+                    .map(|(index, agent)| decide(index, agent))
                     .collect()
             };
-        let decided = match &self.planning_pool {
-            Some(pool) => pool.install(decide_all),
-            None => decide_all(),
+            match &self.planning_pool {
+                Some(pool) => pool.install(decide_all),
+                None => decide_all(),
+            }
         };
         // 3. Counting, events, observers and broadcasts (sequential, by id).
         for (index, (decision, elapsed_us)) in decided.into_iter().enumerate() {
