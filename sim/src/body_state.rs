@@ -41,6 +41,32 @@ impl BodyState {
         0.5 * self.length_m.hypot(self.width_m)
     }
 
+    /// Half the footprint's extent along the unit vector `u` (m): half-length · |u·heading| +
+    /// half-width · |u·left|. The footprint's projection on `u` is its centre's ± this.
+    pub(crate) fn half_extent_along_m(&self, u: [f64; 2]) -> f64 {
+        let (sin_yaw, cos_yaw) = self.yaw_rad.sin_cos();
+        0.5 * self.length_m * (u[0] * cos_yaw + u[1] * sin_yaw).abs()
+            + 0.5 * self.width_m * (-u[0] * sin_yaw + u[1] * cos_yaw).abs()
+    }
+
+    /// A standing box for tests: `id` at `[x_m, y_m, yaw_rad]` with `[length_m, width_m,
+    /// height_m]`.
+    #[cfg(test)]
+    pub(crate) fn standing(id: VehicleId, pose: [f64; 3], size_m: [f64; 3]) -> Self {
+        Self {
+            id,
+            x_m: pose[0],
+            y_m: pose[1],
+            yaw_rad: pose[2],
+            vx_mps: 0.0,
+            vy_mps: 0.0,
+            yaw_rate_radps: 0.0,
+            length_m: size_m[0],
+            width_m: size_m[1],
+            height_m: size_m[2],
+        }
+    }
+
     /// Speed over ground (m/s).
     pub(crate) fn speed_mps(&self) -> f64 {
         self.vx_mps.hypot(self.vy_mps)

@@ -2,15 +2,15 @@
 //! lane down into the lower one and back up, on the straight merge road and on the same road
 //! bent on a 300 m-radius curve (lane membership in the lane frame).
 
+mod common;
+
 use std::sync::Arc;
 
 use mergesim_types::lanes::{LaneId, LaneRoad};
-use mergesim_types::{Behaviour, BehaviourError, Decision, Lane, Observation, PathPoint};
-use sim::config::{Driver, SimConfig, VehicleSpec};
-use sim::recording::Recorder;
+use mergesim_types::{Behaviour, BehaviourError, Decision, Observation, PathPoint};
+use sim::config::{Driver, SimConfig};
 use sim::registry::{BehaviourRegistry, FactoryInput};
 use sim::road_config::{CurvedMergeConfig, LaneRoadConfig};
-use sim::{RunOptions, World};
 
 /// Follows the upper lane's centre, weaves to the lower lane's centre between s = 40 and 60 m
 /// (of the upper lane), holds it to 110 m and weaves back by 130 m: the path is the upper lane's
@@ -61,33 +61,12 @@ fn events_of(config: SimConfig, x_m: f64) -> (Vec<String>, u32) {
             }),
         )
         .unwrap();
-    let specs = [VehicleSpec {
-        name: "weaver".into(),
-        preset: "bmw_320i".into(),
-        vehicle_model: None,
-        lane: Lane::Upper.into(),
-        x_m,
-        y_offset_m: 0.0,
-        speed_mps: 12.0,
-        target_speed_mps: 12.0,
-        driver: Driver::planner("weave"),
-        connected: false,
-        goal: None,
-        route: None,
-    }];
+    let specs = [common::spec("weaver", x_m, 12.0, Driver::planner("weave"))];
     let config = SimConfig {
         duration_s: 16.0,
         ..config
     };
-    let world = World::with_registry(
-        config,
-        &specs,
-        &RunOptions::default(),
-        Recorder::disabled(),
-        &registry,
-    )
-    .unwrap();
-    let outcome = world.run(|_| {}).unwrap();
+    let outcome = common::run_with(config, &specs, &registry);
     let crossings = outcome.vehicles[0]
         .paper_metrics
         .as_ref()

@@ -1,16 +1,14 @@
 //! What a vehicle's behaviour is given: the others within the perception range, and the shared
 //! paths of the connected vehicles within the V2V range of their senders.
 
+mod common;
+
 use std::collections::BTreeSet;
 use std::sync::{Arc, Mutex};
 
-use mergesim_types::{
-    Behaviour, BehaviourError, Decision, Lane, Observation, PathPoint, VehicleId,
-};
+use mergesim_types::{Behaviour, BehaviourError, Decision, Observation, VehicleId};
 use sim::config::{Driver, SimConfig, VehicleSpec};
-use sim::recording::Recorder;
 use sim::registry::{BehaviourRegistry, FactoryInput};
-use sim::{RunOptions, World};
 
 /// What one vehicle was given over the run: neighbour ids and shared-path sender ids.
 #[derive(Debug, Default)]
@@ -32,21 +30,14 @@ impl Behaviour for Witness {
             seen.senders
                 .extend(obs.shared_paths.iter().map(|p| p.vehicle_id));
         }
-        let v = obs.target_speed_mps;
-        let path: Vec<PathPoint> = (0..=20)
-            .map(|i| PathPoint {
-                x_m: obs.ego.x_m + 3.0 * i as f64,
-                y_m: obs
-                    .lanes
-                    .lane(mergesim_types::lanes::THROUGH_LANE_ID)
-                    .map_or(obs.ego.y_m, |l| {
-                        let s_m = l.project([obs.ego.x_m, obs.ego.y_m]).s_m;
-                        l.point(s_m, 0.0)[1]
-                    }),
-                speed_mps: v,
-                t_s: obs.time_s + 3.0 * i as f64 / v,
-            })
-            .collect();
+        let lane_y_m = obs
+            .lanes
+            .lane(mergesim_types::lanes::THROUGH_LANE_ID)
+            .map_or(obs.ego.y_m, |l| {
+                let s_m = l.project([obs.ego.x_m, obs.ego.y_m]).s_m;
+                l.point(s_m, 0.0)[1]
+            });
+        let path = common::straight_path(obs, lane_y_m);
         Ok(Decision::follow_and_share(path, obs))
     }
 }
@@ -73,33 +64,15 @@ fn seen_by_the_first(config: SimConfig) -> Seen {
     let specs: Vec<VehicleSpec> = [("a", 0.0), ("b", 200.0), ("c", 270.0), ("d", 350.0)]
         .into_iter()
         .map(|(name, x_m)| VehicleSpec {
-            name: name.into(),
-            preset: "bmw_320i".into(),
-            vehicle_model: None,
-            lane: Lane::Upper.into(),
-            x_m,
-            y_offset_m: 0.0,
-            speed_mps: 15.0,
-            target_speed_mps: 15.0,
-            driver: Driver::planner("witness"),
             connected: true,
-            goal: None,
-            route: None,
+            ..common::spec(name, x_m, 15.0, Driver::planner("witness"))
         })
         .collect();
     let config = SimConfig {
         duration_s: 0.5,
         ..config
     };
-    let world = World::with_registry(
-        config,
-        &specs,
-        &RunOptions::default(),
-        Recorder::disabled(),
-        &registry,
-    )
-    .unwrap();
-    world.run(|_| {}).unwrap();
+    common::run_with(config, &specs, &registry);
     std::mem::take(&mut *seen.lock().unwrap())
 }
 

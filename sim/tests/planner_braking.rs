@@ -2,13 +2,13 @@
 //! limit on this road, min(μ·g, its brakes'), times `planner_brake_margin`, rounded down to
 //! 0.1 m/s² (docs/vehicle_models.md, "The braking the planners rely on").
 
+mod common;
+
 use std::sync::{Arc, Mutex};
 
-use mergesim_types::{Behaviour, BehaviourError, Decision, Lane, Observation, PathPoint};
+use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
 use sim::config::{Driver, SimConfig, VehicleSpec};
-use sim::recording::Recorder;
 use sim::registry::{BehaviourRegistry, FactoryInput};
-use sim::{RunOptions, World};
 
 /// The a_b values one planner was given: its own, and its neighbours'.
 #[derive(Debug, Default, Clone, PartialEq)]
@@ -31,15 +31,7 @@ impl Behaviour for Witness {
                 .neighbours_mps2
                 .extend(obs.neighbours.iter().map(|n| n.shape.max_brake_decel_mps2));
         }
-        let v = obs.target_speed_mps;
-        let path: Vec<PathPoint> = (0..=20)
-            .map(|i| PathPoint {
-                x_m: obs.ego.x_m + 3.0 * i as f64,
-                y_m: obs.ego.y_m,
-                speed_mps: v,
-                t_s: obs.time_s + 3.0 * i as f64 / v,
-            })
-            .collect();
+        let path = common::straight_path(obs, obs.ego.y_m);
         Ok(Decision::follow_and_share(path, obs))
     }
 }
@@ -65,33 +57,16 @@ fn given_to_the_first(config: SimConfig, vehicle_model: Option<&str>) -> Given {
     let specs: Vec<VehicleSpec> = [("a", 0.0), ("b", 40.0)]
         .into_iter()
         .map(|(name, x_m)| VehicleSpec {
-            name: name.into(),
-            preset: "bmw_320i".into(),
             vehicle_model: vehicle_model.map(str::to_string),
-            lane: Lane::Upper.into(),
-            x_m,
-            y_offset_m: 0.0,
-            speed_mps: 15.0,
-            target_speed_mps: 15.0,
-            driver: Driver::planner("witness"),
             connected: true,
-            goal: None,
-            route: None,
+            ..common::spec(name, x_m, 15.0, Driver::planner("witness"))
         })
         .collect();
     let config = SimConfig {
         duration_s: 0.3,
         ..config
     };
-    let world = World::with_registry(
-        config,
-        &specs,
-        &RunOptions::default(),
-        Recorder::disabled(),
-        &registry,
-    )
-    .unwrap();
-    world.run(|_| {}).unwrap();
+    common::run_with(config, &specs, &registry);
     let out = given.lock().unwrap().clone();
     assert!(!out.own_mps2.is_empty() && !out.neighbours_mps2.is_empty());
     out

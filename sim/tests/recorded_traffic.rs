@@ -2,6 +2,8 @@
 //! planners' observations during the recorded span only, collisions caused by the replay
 //! counted apart, the reactive mode's IDM handover, and determinism.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
@@ -34,22 +36,7 @@ fn recorded(name: &str, states: Vec<RecordedState>) -> RecordedVehicle {
     }
 }
 
-fn spec(name: &str, x_m: f64, speed_mps: f64, driver: Driver) -> VehicleSpec {
-    VehicleSpec {
-        name: name.into(),
-        preset: "bmw_320i".into(),
-        vehicle_model: None,
-        lane: Lane::Upper.into(),
-        x_m,
-        y_offset_m: 0.0,
-        speed_mps,
-        target_speed_mps: speed_mps,
-        driver,
-        connected: false,
-        goal: None,
-        route: None,
-    }
-}
+use common::spec;
 
 fn config(duration_s: f64, mode: TrafficMode, vehicles: Vec<RecordedVehicle>) -> SimConfig {
     SimConfig {

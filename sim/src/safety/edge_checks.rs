@@ -174,10 +174,7 @@ fn box_line_gap_lower_bound_m(body: &BodyState, a: [f64; 2], b: [f64; 2]) -> f64
         return 0.0;
     }
     let n = [-ab[1] / length_m, ab[0] / length_m];
-    let (sin_yaw, cos_yaw) = body.yaw_rad.sin_cos();
-    // Half-extent of the box along n: half-length · |n·heading| + half-width · |n·left|.
-    let extent_m = 0.5 * body.length_m * (n[0] * cos_yaw + n[1] * sin_yaw).abs()
-        + 0.5 * body.width_m * (-n[0] * sin_yaw + n[1] * cos_yaw).abs();
+    let extent_m = body.half_extent_along_m(n);
     let centre_m = (n[0] * (body.x_m - a[0]) + n[1] * (body.y_m - a[1])).abs();
     (centre_m - extent_m).max(0.0)
 }
@@ -211,17 +208,8 @@ mod tests {
 
     #[test]
     fn box_line_bound_is_the_gap_to_the_line() {
-        let body = |x_m: f64, y_m: f64, yaw_rad: f64| BodyState {
-            id: 0,
-            x_m,
-            y_m,
-            yaw_rad,
-            vx_mps: 0.0,
-            vy_mps: 0.0,
-            yaw_rate_radps: 0.0,
-            length_m: 4.0,
-            width_m: 2.0,
-            height_m: 1.5,
+        let body = |x_m: f64, y_m: f64, yaw_rad: f64| {
+            BodyState::standing(0, [x_m, y_m, yaw_rad], [4.0, 2.0, 1.5])
         };
         // Along the line, 3 m from it: 3 − 1 (half-width).
         let lb = box_line_gap_lower_bound_m(&body(0.0, 3.0, 0.0), [-10.0, 0.0], [10.0, 0.0]);

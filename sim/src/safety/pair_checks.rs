@@ -220,12 +220,7 @@ fn centre_axis_gap_lower_bound_m(a: &BodyState, b: &BodyState) -> f64 {
         return 0.0;
     }
     let u = [d[0] / distance_m, d[1] / distance_m];
-    let half_extent_m = |body: &BodyState| {
-        let (sin_yaw, cos_yaw) = body.yaw_rad.sin_cos();
-        0.5 * body.length_m * (u[0] * cos_yaw + u[1] * sin_yaw).abs()
-            + 0.5 * body.width_m * (-u[0] * sin_yaw + u[1] * cos_yaw).abs()
-    };
-    (distance_m - half_extent_m(a) - half_extent_m(b)).max(0.0)
+    (distance_m - a.half_extent_along_m(u) - b.half_extent_along_m(u)).max(0.0)
 }
 
 /// The body's cuboid and its pose relative to the origin (`origin_x_m`, `origin_y_m`, 0):
@@ -252,18 +247,7 @@ mod tests {
     use super::*;
 
     fn body(x_m: f64, y_m: f64, yaw_rad: f64) -> BodyState {
-        BodyState {
-            id: 0,
-            x_m,
-            y_m,
-            yaw_rad,
-            vx_mps: 0.0,
-            vy_mps: 0.0,
-            yaw_rate_radps: 0.0,
-            length_m: 4.0,
-            width_m: 2.0,
-            height_m: 1.5,
-        }
+        BodyState::standing(0, [x_m, y_m, yaw_rad], [4.0, 2.0, 1.5])
     }
 
     /// parry's exact gap of the two boxes.

@@ -83,18 +83,7 @@ mod tests {
     use super::*;
 
     fn body(id: VehicleId, x_m: f64, y_m: f64, yaw_rad: f64) -> BodyState {
-        BodyState {
-            id,
-            x_m,
-            y_m,
-            yaw_rad,
-            vx_mps: 0.0,
-            vy_mps: 0.0,
-            yaw_rate_radps: 0.0,
-            length_m: 4.5,
-            width_m: 1.8,
-            height_m: 1.3,
-        }
+        BodyState::standing(id, [x_m, y_m, yaw_rad], [4.5, 1.8, 1.3])
     }
 
     #[test]
