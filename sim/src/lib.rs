@@ -38,6 +38,7 @@ pub mod goal;
 pub mod idm;
 pub(crate) mod lane_membership;
 pub mod metrics;
+pub mod mobil;
 pub(crate) mod observer;
 pub(crate) mod outcome;
 pub mod paper_metrics;
