@@ -89,11 +89,12 @@ pub fn behaviour_of(
             lane: spec.lane.id(),
             d_offset_m: spec.y_offset_m,
         }),
-        Driver::Idm => Box::new(IdmDriver {
-            params: config.idm.clone(),
-            lane: spec.lane.id(),
-            d_offset_m: spec.y_offset_m,
-        }),
+        Driver::Idm => Box::new(IdmDriver::new(
+            config.idm.clone(),
+            spec.lane.id(),
+            spec.y_offset_m,
+            None,
+        )),
     })
 }
 

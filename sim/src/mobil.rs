@@ -43,6 +43,12 @@ pub struct MobilParams {
     /// Bias a_bias toward leaving a lane that ends (m/s²), added to the incentive of such a
     /// change only.
     pub ending_lane_bias_mps2: f64,
+    /// Least time between two changes of one driver (s): a change is not reconsidered while
+    /// the car is still crossing over.
+    pub min_time_between_changes_s: f64,
+    /// Clearance (m) the car keeps from either bound of a lane that narrows to its end: the
+    /// standing obstacle stands where the car would no longer fit with it.
+    pub end_clearance_m: f64,
 }
 
 impl Default for MobilParams {
@@ -54,6 +60,12 @@ impl Default for MobilParams {
             // Kesting et al.'s keep-right bias a_bias = 0.3 m/s², here toward the lane that
             // continues.
             ending_lane_bias_mps2: 0.3,
+            // Longer than a lane change takes the tracker here (the car reaches the new lane's
+            // centre in about 3 s; to be measured and written down before it is relied on).
+            min_time_between_changes_s: 4.0,
+            // Thirty times the safety checks' contact tolerance (1 cm): room for the tracker's
+            // lateral error (to be measured and written down before it is relied on).
+            end_clearance_m: 0.3,
         }
     }
 }
@@ -64,6 +76,8 @@ pub const MOBIL_BOUNDS: &[Bound] = &[
     Bound::closed("threshold_mps2", 0.0, 10.0, "m/s²"),
     Bound::above("safe_decel_mps2", 0.0, 30.0, "m/s²"),
     Bound::closed("ending_lane_bias_mps2", 0.0, 10.0, "m/s²"),
+    Bound::closed("min_time_between_changes_s", 0.0, 60.0, "s"),
+    Bound::closed("end_clearance_m", 0.0, 5.0, "m"),
 ];
 
 impl MobilParams {
@@ -77,6 +91,11 @@ impl MobilParams {
                 ("threshold_mps2", self.threshold_mps2),
                 ("safe_decel_mps2", self.safe_decel_mps2),
                 ("ending_lane_bias_mps2", self.ending_lane_bias_mps2),
+                (
+                    "min_time_between_changes_s",
+                    self.min_time_between_changes_s,
+                ),
+                ("end_clearance_m", self.end_clearance_m),
             ],
         )?;
         Ok(())

@@ -7,6 +7,6 @@ pub(crate) mod idm_driver;
 pub(crate) mod lane_keeping;
 pub(crate) mod prescribed_speed;
 
-pub(crate) use idm_driver::IdmDriver;
+pub use idm_driver::IdmDriver;
 pub use lane_keeping::{LaneKeeping, lane_path};
 pub(crate) use prescribed_speed::PrescribedSpeed;
