@@ -160,6 +160,24 @@ pub enum ScenarioError {
 /// enough for the run (the trackers hold speeds within a few per cent of their targets).
 pub const ROAD_END_SPEED_ALLOWANCE: f64 = 0.1;
 
+/// The highest speed vehicle `v` can drive (m/s): the largest of its start and target speeds
+/// (with the upper ends of their randomisation `b`) and of its prescribed profile, plus
+/// [`ROAD_END_SPEED_ALLOWANCE`]: what the road-length checks assume for the whole run.
+fn top_speed_mps(v: &VehicleSpec, b: &crate::randomisation::VehicleOffsetBounds) -> f64 {
+    let prescribed_max_mps = match &v.driver {
+        sim::config::Driver::Prescribed { speed_profile, .. } => speed_profile
+            .points
+            .iter()
+            .map(|p| p[1])
+            .fold(0.0, f64::max),
+        _ => 0.0,
+    };
+    (v.speed_mps + b.speed_mps[1])
+        .max(v.target_speed_mps + b.target_speed_mps[1])
+        .max(prescribed_max_mps)
+        * (1.0 + ROAD_END_SPEED_ALLOWANCE)
+}
+
 /// Longest scenario file read (bytes): 16 MiB, far beyond 200 vehicles with comments.
 pub const MAX_SCENARIO_BYTES: u64 = 16 << 20;
 

@@ -111,18 +111,7 @@ impl Scenario {
             // The road must be long enough for the whole run: every vehicle driving the whole
             // duration at the highest speed it starts at, aims at or is prescribed, plus
             // ROAD_END_SPEED_ALLOWANCE for overshoot, stays on it.
-            let prescribed_max_mps = match &v.driver {
-                sim::config::Driver::Prescribed { speed_profile, .. } => speed_profile
-                    .points
-                    .iter()
-                    .map(|p| p[1])
-                    .fold(0.0, f64::max),
-                _ => 0.0,
-            };
-            let top_speed_mps = (v.speed_mps + b.speed_mps[1])
-                .max(v.target_speed_mps + b.target_speed_mps[1])
-                .max(prescribed_max_mps)
-                * (1.0 + ROAD_END_SPEED_ALLOWANCE);
+            let top_speed_mps = top_speed_mps(v, &b);
             let reach_m = x[1] + top_speed_mps * self.sim.duration_s;
             if reach_m > road.end_x_m {
                 return Err(ScenarioError::Invalid {

@@ -162,18 +162,7 @@ impl Scenario {
                 }
             }
             boxes.push((v.name.clone(), swept));
-            let prescribed_max_mps = match &v.driver {
-                sim::config::Driver::Prescribed { speed_profile, .. } => speed_profile
-                    .points
-                    .iter()
-                    .map(|p| p[1])
-                    .fold(0.0, f64::max),
-                _ => 0.0,
-            };
-            let top_speed_mps = (v.speed_mps + b.speed_mps[1])
-                .max(v.target_speed_mps + b.target_speed_mps[1])
-                .max(prescribed_max_mps)
-                * (1.0 + super::ROAD_END_SPEED_ALLOWANCE);
+            let top_speed_mps = super::top_speed_mps(v, &b);
             // On a CommonRoad road a vehicle may drive off the map: that ends the run with an
             // event (`sim::world`), as CommonRoad's maps end where their recordings do.
             if self.sim.commonroad_road().is_some() {

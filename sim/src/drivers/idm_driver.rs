@@ -143,16 +143,15 @@ fn around(
 
 impl IdmDriver {
     /// MOBIL's choice at this tick: the neighbouring lane to change to, if any (module doc).
+    /// `own` is the held lane and `own_users` everybody in its frame ([`in_frame`]).
     fn mobil_target(
         &self,
         mobil: &MobilParams,
         obs: &Observation<'_>,
-    ) -> Result<Option<LaneId>, BehaviourError> {
+        own: &Lane,
+        own_users: &[RoadUser],
+    ) -> Option<LaneId> {
         let lanes = obs.lanes;
-        let Some(own) = lanes.lane(self.lane) else {
-            return Err(format!("lane {} is not on the road", self.lane).into());
-        };
-        let own_users = in_frame(own, obs);
         let s_me = own_users[0].x_m;
         let me = LaneDriver {
             s_m: s_me,
@@ -165,7 +164,7 @@ impl IdmDriver {
             clearance_m: mobil.end_clearance_m,
         };
         let (leader_now, follower_now) =
-            around(&self.params, lanes, self.lane, &own_users, s_me, fit);
+            around(&self.params, lanes, self.lane, own_users, s_me, fit);
         let own_ends = lanes.distance_to_closed_end_m(self.lane, s_me).is_some();
         let mut best: Option<(LaneId, Verdict)> = None;
         for side in [Side::Left, Side::Right] {
@@ -206,7 +205,7 @@ impl IdmDriver {
                 best = Some((target_id, verdict));
             }
         }
-        Ok(best.map(|(id, _)| id))
+        best.map(|(id, _)| id)
     }
 }
 
@@ -215,21 +214,26 @@ impl Behaviour for IdmDriver {
     /// or the lane's closed end), turned into the speed profile of a lane-keeping path; with
     /// MOBIL, after a lane change if one is due.
     fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError> {
+        // Everybody in the held lane's frame: s along it, d across it.
+        let Some(mut lane) = obs.lanes.lane(self.lane) else {
+            return Err(format!("lane {} is not on the road", self.lane).into());
+        };
+        let mut users = in_frame(lane, obs);
         if let Some(mobil) = &self.mobil {
             let rested = self
                 .last_change_t_s
                 .is_none_or(|t| obs.time_s - t >= mobil.min_time_between_changes_s);
-            if rested && let Some(target) = self.mobil_target(mobil, obs)? {
+            if rested
+                && let Some(target) = self.mobil_target(mobil, obs, lane, &users)
+                && let Some(target_lane) = obs.lanes.lane(target)
+            {
                 self.lane = target;
                 self.d_offset_m = 0.0;
                 self.last_change_t_s = Some(obs.time_s);
+                lane = target_lane;
+                users = in_frame(lane, obs);
             }
         }
-        // Everybody in the held lane's frame: s along it, d across it.
-        let Some(lane) = obs.lanes.lane(self.lane) else {
-            return Err(format!("lane {} is not on the road", self.lane).into());
-        };
-        let users = in_frame(lane, obs);
         let leader = if let Some(mobil) = &self.mobil {
             let s_me = users[0].x_m;
             let fit = Fit {
