@@ -12,6 +12,7 @@ use crate::drivers::{IdmDriver, LaneKeeping, PrescribedSpeed};
 use crate::error::SimError;
 use crate::planner_params::{ParamsError, ParamsTable, ParsedParams};
 use crate::registry::{BehaviourRegistry, FactoryInput};
+use crate::shield::{RssShield, ShieldKind};
 
 /// One vehicle and its driver.
 pub struct Agent {
@@ -33,6 +34,9 @@ pub struct Agent {
     pub lane: LaneId,
     /// The degraded mode of its last decision (events on changes).
     pub degraded_mode: Option<mergesim_types::DegradedMode>,
+    /// The shield bounding its planner's decisions (`crate::shield`); `None` without one, and
+    /// for human-driver models.
+    pub shield: Option<RssShield>,
 }
 
 /// The behaviour of `spec`: its planner from the registry (or `planner_override`, which
@@ -94,6 +98,12 @@ pub fn behaviour_of(
             spec.lane.id(),
             spec.y_offset_m,
             None,
+        )),
+        Driver::IdmMobil => Box::new(IdmDriver::new(
+            config.idm.clone(),
+            spec.lane.id(),
+            spec.y_offset_m,
+            Some(config.mobil.clone()),
         )),
     })
 }
@@ -183,6 +193,10 @@ impl Agent {
         ));
         let behaviour = behaviour_of(config, spec, registry, planner_override, lanes)?;
         let tracker = Tracker::new(config.tracker.clone(), &params);
+        let shield = match config.shield {
+            ShieldKind::Rss if behaviour.is_planner() => Some(RssShield::new(config.rss.clone())),
+            ShieldKind::Rss | ShieldKind::None => None,
+        };
         Ok(Self {
             id: index as VehicleId,
             spec: spec.clone(),
@@ -193,6 +207,7 @@ impl Agent {
             path: Vec::new(),
             lane: spec.lane.id(),
             degraded_mode: None,
+            shield,
         })
     }
 }

@@ -17,10 +17,12 @@ pub use driver::Driver;
 use crate::error::SimError;
 use crate::goal::Goal;
 use crate::idm::IdmParams;
+use crate::mobil::MobilParams;
 use crate::planner_params::ParamsTable;
 use crate::recorded_traffic::RecordedTraffic;
 use crate::road_config::{LaneRoadConfig, StartLane, build_lane_road};
 use crate::safety::SafetyParams;
+use crate::shield::{RssParams, ShieldKind};
 use crate::v2v::V2vParams;
 
 /// Settings shared by every vehicle of a run.
@@ -77,8 +79,22 @@ pub struct SimConfig {
     pub tracker: TrackerParams,
     /// Collision, gap and TTC thresholds.
     pub safety: SafetyParams,
-    /// Intelligent Driver Model of the human-driven (`driver = "idm"`) vehicles.
+    /// Intelligent Driver Model of the human-driven (`driver = "idm"` and `"idm-mobil"`)
+    /// vehicles.
     pub idm: IdmParams,
+    /// MOBIL lane changes of the `driver = "idm-mobil"` vehicles (`[sim.mobil]`). Written out
+    /// only when it differs from the defaults, so a scenario without it keeps its canonical
+    /// form (and its sweep fingerprint).
+    #[serde(skip_serializing_if = "MobilParams::is_default")]
+    pub mobil: MobilParams,
+    /// The safety shield the planner-driven vehicles wear (`crate::shield`): `"none"` (the
+    /// default) or `"rss"`. Written out only when on.
+    #[serde(skip_serializing_if = "ShieldKind::is_none")]
+    pub shield: ShieldKind,
+    /// Responsibility-Sensitive Safety's parameters for `shield = "rss"` (`[sim.rss]`). Written
+    /// out only when they differ from the defaults.
+    #[serde(skip_serializing_if = "RssParams::is_default")]
+    pub rss: RssParams,
     /// Recorded vehicles replayed beside the simulated ones (`crate::recorded_traffic`): filled
     /// by the scenario loader from the road's source file, never written in a scenario.
     #[serde(skip)]
@@ -106,6 +122,9 @@ impl Default for SimConfig {
             tracker: TrackerParams::default(),
             safety: SafetyParams::default(),
             idm: IdmParams::default(),
+            mobil: MobilParams::default(),
+            shield: ShieldKind::None,
+            rss: RssParams::default(),
             recorded_traffic: RecordedTraffic::default(),
         }
     }
@@ -232,6 +251,8 @@ impl SimConfig {
         }
         self.v2v.validate()?;
         self.idm.validate()?;
+        self.mobil.validate()?;
+        self.rss.validate()?;
         self.safety.validate().map_err(SimError::from)?;
         self.tracker.validate()?;
         self.planner.validate()?;

@@ -4,37 +4,18 @@
 
 mod common;
 
-use std::sync::Arc;
-
-use mergesim_types::{Behaviour, Lane};
+use mergesim_types::Lane;
 use sim::RunOutcome;
 use sim::config::{Driver, SimConfig, VehicleSpec};
-use sim::drivers::IdmDriver;
-use sim::idm::IdmParams;
-use sim::mobil::MobilParams;
-use sim::registry::{BehaviourRegistry, FactoryInput};
+use sim::registry::BehaviourRegistry;
 
-/// Runs `specs` with an `idm-mobil` driver registered (IDM + MOBIL, default parameters).
+/// Runs `specs` with the default parameters (`driver = "idm-mobil"`: IDM + MOBIL).
 fn run(specs: &[VehicleSpec], duration_s: f64) -> RunOutcome {
-    let mut registry = BehaviourRegistry::builtin();
-    registry
-        .register(
-            "idm-mobil",
-            Arc::new(|input: &FactoryInput<'_>| {
-                Ok(Box::new(IdmDriver::new(
-                    IdmParams::default(),
-                    input.spec.lane.id(),
-                    input.spec.y_offset_m,
-                    Some(MobilParams::default()),
-                )) as Box<dyn Behaviour>)
-            }),
-        )
-        .unwrap();
     let config = SimConfig {
         duration_s,
         ..SimConfig::default()
     };
-    common::run_with(config, specs, &registry)
+    common::run_with(config, specs, &BehaviourRegistry::builtin())
 }
 
 /// The lane changes of the run as (vehicle, time, x).
@@ -66,10 +47,7 @@ fn in_lower_lane(name: &str, x_m: f64, driver: Driver) -> VehicleSpec {
 
 #[test]
 fn on_an_empty_road_it_leaves_the_ending_lane() {
-    let outcome = run(
-        &[in_lower_lane("merger", 0.0, Driver::planner("idm-mobil"))],
-        20.0,
-    );
+    let outcome = run(&[in_lower_lane("merger", 0.0, Driver::IdmMobil)], 20.0);
     let changes = lane_changes(&outcome);
     assert_eq!(changes.len(), 1, "{changes:?}");
     assert!(
@@ -112,7 +90,7 @@ fn into_a_busy_lane_it_waits_for_a_gap_and_does_not_crash() {
             )
         })
         .collect();
-    specs.push(in_lower_lane("merger", 0.0, Driver::planner("idm-mobil")));
+    specs.push(in_lower_lane("merger", 0.0, Driver::IdmMobil));
     let outcome = run(&specs, 40.0);
     let changes = lane_changes(&outcome);
     assert_eq!(changes.len(), 1, "{changes:?}");

@@ -4,7 +4,7 @@
 //! driver = { planner = "pf-iso" }                                  # a registered planner
 //! driver = { planner = "pf-iso", params = { waypoint_count = 16 } } # with its own parameters
 //! driver = { prescribed = { path_planner = "pf-iso", speed_profile = [[0.0, 20.0]] } }
-//! driver = "idm"                                                   # or "lane-keeping"
+//! driver = "idm"                                                   # or "idm-mobil", "lane-keeping"
 //! ```
 //!
 //! The `params` table may also be written under a `[vehicles.driver.params]` header.
@@ -47,6 +47,10 @@ pub enum Driver {
     /// A human driver: Intelligent Driver Model car following (Treiber et al. 2000) with lane
     /// keeping; never changes lanes, never connected.
     Idm,
+    /// A human driver who changes lanes: IDM car following with MOBIL lane changes (Kesting,
+    /// Treiber & Helbing 2007; `crate::mobil`, parameters `[sim.mobil]`). A lane that ends is a
+    /// standing obstacle at its end until MOBIL finds a gap. Never connected.
+    IdmMobil,
 }
 
 impl Driver {
@@ -76,7 +80,7 @@ impl Driver {
 }
 
 /// The names a driver is written with.
-const FORMS: &[&str] = &["planner", "prescribed", "lane-keeping", "idm"];
+const FORMS: &[&str] = &["planner", "prescribed", "lane-keeping", "idm", "idm-mobil"];
 /// The keys of a driver table.
 const KEYS: &[&str] = &["planner", "params", "prescribed"];
 
@@ -122,6 +126,7 @@ impl Serialize for Driver {
             }
             Self::LaneKeeping => serializer.serialize_str("lane-keeping"),
             Self::Idm => serializer.serialize_str("idm"),
+            Self::IdmMobil => serializer.serialize_str("idm-mobil"),
         }
     }
 }
@@ -140,7 +145,8 @@ impl<'de> Visitor<'de> for DriverVisitor {
     fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(
             "a driver: { planner = \"NAME\" } (optionally with params = { … }), \
-             { prescribed = { path_planner, speed_profile } }, \"lane-keeping\" or \"idm\"",
+             { prescribed = { path_planner, speed_profile } }, \"lane-keeping\", \"idm\" or \
+             \"idm-mobil\"",
         )
     }
 
@@ -148,6 +154,7 @@ impl<'de> Visitor<'de> for DriverVisitor {
         match value {
             "lane-keeping" => Ok(Driver::LaneKeeping),
             "idm" => Ok(Driver::Idm),
+            "idm-mobil" => Ok(Driver::IdmMobil),
             other => Err(E::unknown_variant(other, FORMS)),
         }
     }
@@ -164,7 +171,7 @@ impl<'de> Visitor<'de> for DriverVisitor {
                 "planner" => return Err(de::Error::duplicate_field("planner")),
                 "params" => return Err(de::Error::duplicate_field("params")),
                 "prescribed" => return Err(de::Error::duplicate_field("prescribed")),
-                "lane-keeping" | "idm" => {
+                "lane-keeping" | "idm" | "idm-mobil" => {
                     return Err(de::Error::custom(format!(
                         "write this driver as a string: driver = \"{key}\""
                     )));
@@ -186,7 +193,7 @@ impl<'de> Visitor<'de> for DriverVisitor {
             )),
             (None, None, None) => Err(de::Error::custom(
                 "an empty driver: write driver = { planner = \"NAME\" }, a prescribed driver, \
-                 \"lane-keeping\" or \"idm\"",
+                 \"lane-keeping\", \"idm\" or \"idm-mobil\"",
             )),
         }
     }
@@ -215,6 +222,7 @@ mod tests {
             "driver = { prescribed = { path_planner = \"pf-iso\", speed_profile = [[0.0, 20.0]] } }",
             "driver = \"lane-keeping\"",
             "driver = \"idm\"",
+            "driver = \"idm-mobil\"",
         ] {
             let driver = read(text).unwrap();
             let written = toml::to_string(&Holder {

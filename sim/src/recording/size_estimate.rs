@@ -38,7 +38,9 @@ pub fn estimated_bytes(
         .filter(|s| {
             !matches!(
                 s.driver,
-                crate::config::Driver::Idm | crate::config::Driver::LaneKeeping
+                crate::config::Driver::Idm
+                    | crate::config::Driver::IdmMobil
+                    | crate::config::Driver::LaneKeeping
             )
         })
         .count() as f64;

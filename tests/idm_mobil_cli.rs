@@ -1,0 +1,143 @@
+//! `driver = "idm-mobil"` from a scenario file, as a user would write it: a human driver who
+//! changes lanes (IDM with MOBIL), its `[sim.mobil]` table, and the errors of bad input.
+
+mod common;
+
+use common::{merge_sim, scratch, stderr};
+
+/// The built-in urgent merge's file with the ego's driver replaced by `driver` and `extra`
+/// appended at its end (a new table).
+fn urgent_merge_with(driver: &str, extra: &str) -> String {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/builtin/urgent_merge.toml"
+    ))
+    .unwrap();
+    let ego_driver = "driver = { planner = \"pf-iso\" }";
+    let at = text.find(ego_driver).expect("the ego's driver line");
+    let mut out = String::new();
+    out.push_str(&text[..at]);
+    out.push_str(&format!("driver = {driver}"));
+    out.push_str(&text[at + ego_driver.len()..]);
+    out.push('\n');
+    out.push_str(extra);
+    out
+}
+
+/// `merge_sim run --scenario FILE --json FILE.json`, parsed.
+fn run_json(path: &std::path::Path) -> serde_json::Value {
+    let json = path.with_extension("json");
+    let out = merge_sim(&[
+        "run",
+        "--scenario",
+        path.to_str().unwrap(),
+        "--no-rrd",
+        "--quiet",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap()
+}
+
+/// The ego's lane-change events.
+fn lane_changes_of_ego(summary: &serde_json::Value) -> Vec<String> {
+    summary["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|e| e.as_str())
+        .filter(|e| e.contains("ego") && e.contains("lane"))
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn an_idm_mobil_ego_merges_in_the_urgent_merge_where_a_plain_idm_ego_hits_the_lane_end() {
+    let dir = scratch("idm_mobil_urgent_merge");
+    // The plain IDM driver never changes lanes: the narrowing lane carries it into the edge.
+    let plain = dir.join("plain.toml");
+    std::fs::write(&plain, urgent_merge_with("\"idm\"", "")).unwrap();
+    let plain = run_json(&plain);
+    assert!(
+        plain["collisions"].as_u64().unwrap() > 0,
+        "the plain IDM ego was expected to touch the edge: {plain}"
+    );
+    // With MOBIL it changes into the through lane, behind or ahead of the obstacle, untouched.
+    let mobil = dir.join("mobil.toml");
+    std::fs::write(&mobil, urgent_merge_with("\"idm-mobil\"", "")).unwrap();
+    let summary = run_json(&mobil);
+    assert_eq!(summary["collisions"], 0, "{summary}");
+    let changes = lane_changes_of_ego(&summary);
+    assert!(!changes.is_empty(), "no lane change of the ego: {summary}");
+    // It travelled the whole run (never stuck at the lane's end): more than 25 s × 10 m/s.
+    let ego = summary["vehicles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|v| v["id"] == "ego")
+        .unwrap();
+    assert!(ego["path_length_m"].as_f64().unwrap() > 250.0, "{ego}");
+}
+
+#[test]
+fn the_mobil_table_is_read_and_checked() {
+    let dir = scratch("idm_mobil_table");
+    // A politeness of 0 and no bias still merges (the lane's end is a standing obstacle, so
+    // staying has the lower acceleration), and the table is echoed back in the canonical form.
+    let path = dir.join("selfish.toml");
+    std::fs::write(
+        &path,
+        urgent_merge_with(
+            "\"idm-mobil\"",
+            "[sim.mobil]\npoliteness = 0.0\nending_lane_bias_mps2 = 0.0\n",
+        ),
+    )
+    .unwrap();
+    let summary = run_json(&path);
+    assert_eq!(summary["collisions"], 0, "{summary}");
+    assert!(!lane_changes_of_ego(&summary).is_empty(), "{summary}");
+
+    // Out of range: exit 2, the file, the line and the field, and no output written.
+    let bad = dir.join("bad.toml");
+    let text = urgent_merge_with("\"idm-mobil\"", "[sim.mobil]\npoliteness = -1.0\n");
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("politeness"))
+        .unwrap()
+        + 1;
+    std::fs::write(&bad, &text).unwrap();
+    let json = dir.join("out.json");
+    let out = merge_sim(&[
+        "run",
+        "--scenario",
+        bad.to_str().unwrap(),
+        "--no-rrd",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("bad.toml"), "{err}");
+    assert!(err.contains("mobil.politeness"), "{err}");
+    assert!(err.contains(&format!("line {line}")), "line {line}: {err}");
+    assert!(!json.exists());
+
+    // An unknown key and a misspelt driver name are refused alike, naming what is valid.
+    let typo = dir.join("typo.toml");
+    std::fs::write(
+        &typo,
+        urgent_merge_with("\"idm-mobil\"", "[sim.mobil]\npoliteness_factor = 0.1\n"),
+    )
+    .unwrap();
+    let out = merge_sim(&["run", "--scenario", typo.to_str().unwrap(), "--no-rrd"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("politeness_factor"), "{err}");
+    let misspelt = dir.join("misspelt.toml");
+    std::fs::write(&misspelt, urgent_merge_with("\"idm-mobl\"", "")).unwrap();
+    let out = merge_sim(&["run", "--scenario", misspelt.to_str().unwrap(), "--no-rrd"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("idm-mobil"), "{err}");
+}
