@@ -15,7 +15,9 @@ use sim::config::{
     VEHICLE_BOUNDS,
 };
 use sim::idm::IDM_BOUNDS;
+use sim::mobil::MOBIL_BOUNDS;
 use sim::safety::SAFETY_BOUNDS;
+use sim::shield::rss_rules::RSS_BOUNDS;
 use sim::v2v::V2V_BOUNDS;
 use vehicles::tracker::TRACKER_BOUNDS;
 
@@ -30,6 +32,8 @@ pub fn scenario_tables() -> Vec<(&'static str, &'static [Bound])> {
         ("sim.safety", SAFETY_BOUNDS),
         ("sim.v2v", V2V_BOUNDS),
         ("sim.idm", IDM_BOUNDS),
+        ("sim.mobil", MOBIL_BOUNDS),
+        ("sim.rss", RSS_BOUNDS),
         ("[vehicles]", VEHICLE_BOUNDS),
     ]
 }
@@ -91,6 +95,10 @@ pub fn other_limits() -> Vec<(String, String)> {
         (
             "`[sim.idm]` decelerations".into(),
             "`comfortable_decel_mps2` ≤ `max_decel_mps2`".into(),
+        ),
+        (
+            "`[sim.rss]` braking".into(),
+            "`brake_min_mps2` ≤ `brake_max_mps2`".into(),
         ),
         (
             "scenario file".into(),

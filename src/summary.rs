@@ -58,6 +58,10 @@ pub struct RunSummary {
     pub near_miss: bool,
     /// Time spent with TTC below the threshold (s).
     pub tet_s: f64,
+    /// How many times a vehicle's safety shield intervened (`[sim] shield`; a pair turning
+    /// RSS-dangerous, each an event below); 0 without a shield.
+    #[serde(default)]
+    pub shield_interventions: usize,
     /// Per-vehicle metrics.
     pub vehicles: Vec<sim::metrics::VehicleMetricsSummary>,
     /// Planner counters and timing.
@@ -104,6 +108,11 @@ impl RunSummary {
             min_ttc_s: outcome.safety.min_ttc_s,
             near_miss: outcome.safety.near_miss,
             tet_s: outcome.safety.tet_s,
+            shield_interventions: outcome
+                .events
+                .iter()
+                .filter(|e| matches!(e, sim::SimEvent::ShieldIntervened { .. }))
+                .count(),
             vehicles: outcome.vehicles.clone(),
             planner_stats: outcome.planner_stats.clone(),
             goal_reached: outcome.goals.first().map(|g| g.reached),

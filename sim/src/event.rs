@@ -92,6 +92,22 @@ pub enum SimEvent {
         /// Where: y (m).
         y_m: f64,
     },
+    /// A shielded vehicle's pair with another turned RSS-dangerous (`crate::shield`): the
+    /// shield bounds its planner's paths by the proper response until it is no longer.
+    ShieldIntervened {
+        /// When (s).
+        t_s: f64,
+        /// The shielded vehicle.
+        vehicle: String,
+        /// The other vehicle of the dangerous pair.
+        other: String,
+        /// The proper response: `longitudinal`, `lateral` or `longitudinal+lateral`.
+        response: String,
+        /// The bumper-to-bumper gap along the lane (m).
+        lon_gap_m: f64,
+        /// The safe longitudinal gap (m).
+        safe_lon_gap_m: f64,
+    },
     /// A vehicle's planner entered a degraded mode (`Decision::degraded_mode`).
     DegradedModeEntered {
         /// When (s).
@@ -137,6 +153,7 @@ impl SimEvent {
                 EventLevel::Info
             }
             Self::LeftMap { .. }
+            | Self::ShieldIntervened { .. }
             | Self::DegradedModeEntered { .. }
             | Self::DegradedModeLeft { .. }
             | Self::PlannerFallback { .. }
@@ -219,6 +236,19 @@ impl fmt::Display for SimEvent {
                 f,
                 "t = {t_s:.2} s: {vehicle} changed lanes {direction}, from lane {from_lane} to \
                  lane {to_lane}, at x = {x_m:.1} m, y = {y_m:.1} m"
+            ),
+            Self::ShieldIntervened {
+                t_s,
+                vehicle,
+                other,
+                response,
+                lon_gap_m,
+                safe_lon_gap_m,
+            } => write!(
+                f,
+                "t = {t_s:.2} s: the shield of {vehicle} intervened ({response} response): \
+                 {other} is RSS-dangerous, {lon_gap_m:.1} m apart where {safe_lon_gap_m:.1} m \
+                 are safe"
             ),
             Self::DegradedModeEntered { t_s, vehicle, mode } => {
                 write!(f, "t = {t_s:.2} s: {vehicle} plans in degraded mode {mode}")

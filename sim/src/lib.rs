@@ -56,6 +56,7 @@ pub mod road_drawing;
 pub mod route;
 pub(crate) mod run_log;
 pub mod safety;
+pub mod shield;
 pub mod spatial;
 pub mod v2v;
 pub mod vehicle_models;

@@ -116,6 +116,12 @@ pub(crate) struct ScenarioArgs {
     /// model, Magic-Formula tyres); docs/vehicle_models.md.
     #[arg(long, value_name = "MODEL")]
     pub(crate) vehicle_model: Option<String>,
+    /// Safety shield of every planner-driven vehicle, instead of the scenario's `[sim] shield`:
+    /// `none` or `rss` (Responsibility-Sensitive Safety: in a dangerous situation the planned
+    /// path is bounded by RSS's proper response; parameters `[sim.rss]`, docs/parameters.md).
+    /// Human-driver models (`idm`, `idm-mobil`) are never shielded.
+    #[arg(long, value_name = "SHIELD", value_parser = parse_shield)]
+    pub(crate) shield: Option<sim::shield::ShieldKind>,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -392,6 +398,15 @@ pub(crate) fn parse_traffic_mode(text: &str) -> Result<sim::recorded_traffic::Tr
         other => Err(format!(
             "unknown mode {other:?} (valid: none, replay, reactive)"
         )),
+    }
+}
+
+pub(crate) fn parse_shield(text: &str) -> Result<sim::shield::ShieldKind, String> {
+    use sim::shield::ShieldKind;
+    match text {
+        "none" => Ok(ShieldKind::None),
+        "rss" => Ok(ShieldKind::Rss),
+        other => Err(format!("unknown shield {other:?} (valid: none, rss)")),
     }
 }
 

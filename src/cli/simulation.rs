@@ -10,8 +10,8 @@ use sim::recording::{Recorder, RecorderParams};
 use crate::cli::{Failure, Session, args, input, interrupted, run_failure};
 use crate::experiment::{Finished, InstanceOptions, RunError, planner_label, run_instance};
 
-/// Loads the scenario of `--scenario`, with `--params`, `--recorded-traffic`, `--duration` and
-/// `--vehicle-model` applied, and checks its planners and their parameter tables against `registry` (a name
+/// Loads the scenario of `--scenario`, with `--params`, `--recorded-traffic`, `--duration`,
+/// `--vehicle-model` and `--shield` applied, and checks its planners and their parameter tables against `registry` (a name
 /// or a table the registry refuses is bad input, with the file, line and field).
 pub(crate) fn load_source(
     source: &args::ScenarioArgs,
@@ -26,6 +26,9 @@ pub(crate) fn load_source(
     }
     if let Some(model) = &source.vehicle_model {
         scenario = scenario.with_vehicle_model(model);
+    }
+    if let Some(shield) = source.shield {
+        scenario.sim.shield = shield;
     }
     scenario.check_planners(registry).map_err(input)?;
     let traffic = &scenario.sim.recorded_traffic;

@@ -137,8 +137,23 @@ impl World {
         };
         // 3. Counting, events, observers and broadcasts (sequential, by id).
         for (index, (decision, elapsed_us)) in decided.into_iter().enumerate() {
-            let decision = decision?;
+            let mut decision = decision?;
             let observation = observation_of(index, &self.agents[index]);
+            // The shield bounds the decided path before anybody sees it (`crate::shield`).
+            if let Some(shield) = &mut self.agents[index].shield {
+                let started = shield.apply(&observation, &mut decision);
+                for intervention in started {
+                    let event = SimEvent::ShieldIntervened {
+                        t_s,
+                        vehicle: self.agents[index].spec.name.clone(),
+                        other: Self::name_of(&self.names(), intervention.other),
+                        response: intervention.responses.name().to_string(),
+                        lon_gap_m: intervention.lon_gap_m,
+                        safe_lon_gap_m: intervention.safety.safe_lon_gap_m,
+                    };
+                    self.event(event)?;
+                }
+            }
             let agent = &self.agents[index];
             let is_planner = agent.behaviour.is_planner();
             let name = agent.spec.name.clone();
