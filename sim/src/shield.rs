@@ -9,7 +9,12 @@
 //! lane, d across, positive to the left; speeds resolved along and across the lane's heading):
 //!
 //! 1. **Judge** the pair: is the longitudinal gap safe (Definition 1; the rear car's response
-//!    time), is the lateral gap safe (Definition 7)? Dangerous when neither is.
+//!    time), is the lateral gap safe (Definition 7)? Dangerous when neither is. The pair is
+//!    judged twice: now, and at the next check (one planning period ahead) with the shielded
+//!    car where its decided path puts it and the other coasting. Dangerous at either is
+//!    dangerous. The planners accelerate sideways far harder than RSS assumes of a car
+//!    (a^lat_max,accel), so a judgement of the present alone would let a plan turn the pair
+//!    dangerous between two checks, and release and re-engage the bound tick after tick.
 //! 2. **Blame time.** While a pair is not dangerous, the shield remembers its judgement. When it
 //!    turns dangerous, the remembered judgement fixes the proper response (Definition 10): the
 //!    longitudinal one if the longitudinal gap was safe just before, the lateral one if the
@@ -25,8 +30,15 @@
 //!      position now (d clamped at the current d on the other's side); the tracker then brings
 //!      the lateral speed toward the other to zero as fast as it follows the path, not at
 //!      exactly a^lat_min,brake.
+//! 4. **The road's edge** is a standing object (RSS's front car at speed 0). Walk the bounded
+//!    path, and past its end its last direction, up to the safe gap to a standing object. The
+//!    edge is ahead at the first point where the car's side would come within the lateral
+//!    margin μ of it, closer than it is now. If the gap to that point, less half the car's
+//!    length, is below the safe one, the path's speeds are capped to stop there braking at
+//!    a_min,brake. Without this a lateral bound could hold a car on its course into a lane
+//!    that closes.
 //!
-//! An **intervention** is a pair turning dangerous: the world logs a
+//! An **intervention** is a pair (or the edge ahead) turning dangerous: the world logs a
 //! `SimEvent::ShieldIntervened` naming the vehicle, the other and the responses, counted in
 //! the run's summary (`shield_interventions`) and written to the recording's event log. The
 //! message the vehicle broadcasts over V2V stays its planner's: the others hear the plan, not
@@ -34,7 +46,7 @@
 
 use std::collections::BTreeMap;
 
-use mergesim_types::lanes::Lane;
+use mergesim_types::lanes::{Lane, LaneRoad};
 use mergesim_types::{Decision, Observation, PathPoint, VehicleId, VehicleShape, VehicleState};
 use serde::{Deserialize, Serialize};
 
@@ -74,8 +86,8 @@ struct PairMemory {
 /// A pair that turned dangerous this tick.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Intervention {
-    /// The other vehicle.
-    pub other: VehicleId,
+    /// The other vehicle; `None`: the road's edge ahead on the path.
+    pub other: Option<VehicleId>,
     /// The responses the blame time called for.
     pub responses: Responses,
     /// The judgement that found the pair dangerous.
@@ -88,7 +100,44 @@ pub struct Intervention {
 #[derive(Clone, Debug)]
 pub struct RssShield {
     params: RssParams,
+    /// How far ahead (s) the decided path is checked: the time to the next check, one planning
+    /// period.
+    check_ahead_s: f64,
     memory: BTreeMap<VehicleId, PairMemory>,
+    /// Whether the road's edge ahead on the path was dangerous at the last tick.
+    edge_dangerous: bool,
+}
+
+/// The car's state where `path` puts it at `t_s` (linear between its points by their times;
+/// heading along the path); `None` for a path of fewer than two points.
+fn state_on_path(path: &[PathPoint], t_s: f64) -> Option<VehicleState> {
+    let k = path
+        .windows(2)
+        .position(|w| w[1].t_s >= t_s)
+        .unwrap_or(path.len().checked_sub(2)?);
+    let (a, b) = (path.get(k)?, path.get(k + 1)?);
+    let span_s = b.t_s - a.t_s;
+    let w = if span_s > 0.0 {
+        ((t_s - a.t_s) / span_s).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    Some(VehicleState {
+        x_m: a.x_m + w * (b.x_m - a.x_m),
+        y_m: a.y_m + w * (b.y_m - a.y_m),
+        yaw_rad: (b.y_m - a.y_m).atan2(b.x_m - a.x_m),
+        speed_mps: a.speed_mps + w * (b.speed_mps - a.speed_mps),
+    })
+}
+
+/// The state `dt_s` later at constant speed and heading.
+fn coasting(s: &VehicleState, dt_s: f64) -> VehicleState {
+    let (sin, cos) = s.yaw_rad.sin_cos();
+    VehicleState {
+        x_m: s.x_m + s.speed_mps * cos * dt_s,
+        y_m: s.y_m + s.speed_mps * sin * dt_s,
+        ..*s
+    }
 }
 
 /// Speed along and across a lane of heading `heading_rad` (m/s).
@@ -124,11 +173,14 @@ pub fn pair_geometry(
 }
 
 impl RssShield {
-    /// A shield with `params` and nothing remembered.
-    pub fn new(params: RssParams) -> Self {
+    /// A shield with `params` and nothing remembered, checking the decided path `check_ahead_s`
+    /// ahead (the planning period: until the next check).
+    pub fn new(params: RssParams, check_ahead_s: f64) -> Self {
         Self {
             params,
+            check_ahead_s,
             memory: BTreeMap::new(),
+            edge_dangerous: false,
         }
     }
 
@@ -146,10 +198,23 @@ impl RssShield {
         let mut right_limit_m = f64::NEG_INFINITY;
         let my_d_m = lane.project([obs.ego.x_m, obs.ego.y_m]).d_m;
         let mut seen: Vec<VehicleId> = Vec::with_capacity(obs.neighbours.len());
+        // Where the decided path puts the car at the next check.
+        let t_next_s = obs.time_s + self.check_ahead_s;
+        let me_next = state_on_path(&decision.path, t_next_s).unwrap_or(obs.ego);
         for n in obs.neighbours {
             seen.push(n.id);
             let g = pair_geometry(lane, &obs.ego, &obs.ego_shape, &n.state, &n.shape);
-            let safety = judge(&g, &self.params);
+            let now = judge(&g, &self.params);
+            let n_next = coasting(&n.state, self.check_ahead_s);
+            let g_next = pair_geometry(lane, &me_next, &obs.ego_shape, &n_next, &n.shape);
+            let next = judge(&g_next, &self.params);
+            // Dangerous now, or at the next check if the path is followed: the judgement that
+            // says so stands for the pair this tick.
+            let safety = if now.dangerous() || !next.dangerous() {
+                now
+            } else {
+                next
+            };
             let memory = self.memory.entry(n.id).or_insert(PairMemory {
                 last_safe: None,
                 responding: None,
@@ -165,7 +230,7 @@ impl RssShield {
                     let r = Responses::at_blame_time(memory.last_safe.as_ref());
                     memory.responding = Some(r);
                     started.push(Intervention {
-                        other: n.id,
+                        other: Some(n.id),
                         responses: r,
                         safety,
                         lon_gap_m: g.lon_gap_m,
@@ -196,6 +261,47 @@ impl RssShield {
                 obs.time_s,
             );
         }
+        // The road's edge, a standing object: where the (bounded) path would bring the car's
+        // side within the lateral margin of it, closer than the car is now.
+        let need_m = 0.5 * obs.ego_shape.width_m + self.params.lat_margin_m;
+        let safe_m = rss_rules::safe_longitudinal_gap_m(
+            obs.ego.speed_mps,
+            0.0,
+            self.params.response_time_s,
+            &self.params,
+        );
+        let half_length_m = 0.5 * obs.ego_shape.length_m;
+        let edge = edge_ahead_m(&decision.path, obs.lanes, need_m, safe_m + half_length_m)
+            .map(|along_m| along_m - half_length_m);
+        let edge_dangerous = edge.map(|gap_m| (gap_m, safe_m, gap_m < safe_m));
+        match edge_dangerous {
+            Some((gap_m, safe_m, true)) => {
+                if !self.edge_dangerous {
+                    started.push(Intervention {
+                        other: None,
+                        responses: Responses {
+                            longitudinal: true,
+                            lateral: false,
+                        },
+                        safety: PairSafety {
+                            lon_safe: false,
+                            lat_safe: false,
+                            safe_lon_gap_m: safe_m,
+                            safe_lat_gap_m: need_m,
+                        },
+                        lon_gap_m: gap_m,
+                    });
+                }
+                self.edge_dangerous = true;
+                stop_before(
+                    &mut decision.path,
+                    gap_m,
+                    self.params.brake_min_mps2,
+                    obs.time_s,
+                );
+            }
+            _ => self.edge_dangerous = false,
+        }
         started
     }
 }
@@ -211,6 +317,79 @@ fn hold_lateral(path: &mut [PathPoint], lane: &Lane, min_d_m: f64, max_d_m: f64)
             p.x_m = x_m;
             p.y_m = y_m;
         }
+    }
+}
+
+/// How far along `path` (m) the first point lies whose distance to the road's edge is below
+/// `need_m` and below the path's start's: the path heads toward the edge there. Past the path's
+/// end, its last segment is extended straight in [`EDGE_STEP_M`] steps up to `look_m` along
+/// the path. `None` if no point does.
+fn edge_ahead_m(path: &[PathPoint], lanes: &LaneRoad, need_m: f64, look_m: f64) -> Option<f64> {
+    let first = path.first()?;
+    let start_m = lanes.signed_distance_to_edge_m([first.x_m, first.y_m]);
+    let blocked = |p: [f64; 2]| {
+        let clearance_m = lanes.signed_distance_to_edge_m(p);
+        clearance_m < need_m && clearance_m < start_m
+    };
+    let mut along_m = 0.0;
+    for k in 1..path.len() {
+        let (a, b) = (&path[k - 1], &path[k]);
+        along_m += (b.x_m - a.x_m).hypot(b.y_m - a.y_m);
+        if blocked([b.x_m, b.y_m]) {
+            return Some(along_m);
+        }
+    }
+    // The last segment's direction, extended.
+    let (a, b) = match path {
+        [.., a, b] => (a, b),
+        _ => return None,
+    };
+    let length_m = (b.x_m - a.x_m).hypot(b.y_m - a.y_m);
+    if length_m <= 0.0 {
+        return None;
+    }
+    let (ux, uy) = ((b.x_m - a.x_m) / length_m, (b.y_m - a.y_m) / length_m);
+    let steps = ((look_m - along_m) / EDGE_STEP_M).ceil().clamp(0.0, 1e4) as usize;
+    (1..=steps)
+        .map(|k| k as f64 * EDGE_STEP_M)
+        .find(|&beyond_m| blocked([b.x_m + ux * beyond_m, b.y_m + uy * beyond_m]))
+        .map(|beyond_m| along_m + beyond_m)
+}
+
+/// Step (m) of the look past a path's end for the road's edge.
+const EDGE_STEP_M: f64 = 1.0;
+
+/// Caps the path's speeds to stop `stop_m` along it, braking at `brake_mps2`, and times its
+/// points by the new speeds if any was lowered (as [`cap_by_braking`]).
+fn stop_before(path: &mut [PathPoint], stop_m: f64, brake_mps2: f64, t0_s: f64) {
+    let mut along_m = 0.0;
+    let mut lowered = false;
+    for k in 0..path.len() {
+        if k > 0 {
+            along_m += (path[k].x_m - path[k - 1].x_m).hypot(path[k].y_m - path[k - 1].y_m);
+        }
+        let cap_mps = (2.0 * brake_mps2 * (stop_m - along_m)).max(0.0).sqrt();
+        if path[k].speed_mps > cap_mps {
+            path[k].speed_mps = cap_mps;
+            lowered = true;
+        }
+    }
+    if lowered {
+        retime(path, t0_s);
+    }
+}
+
+/// Times the path's points by their speeds from `t0_s` (a standing stretch gets the time of a
+/// crawl at [`CRAWL_MPS`]).
+fn retime(path: &mut [PathPoint], t0_s: f64) {
+    for k in 0..path.len() {
+        path[k].t_s = if k == 0 {
+            t0_s
+        } else {
+            let (a, b) = (&path[k - 1], &path[k]);
+            let ds_m = (b.x_m - a.x_m).hypot(b.y_m - a.y_m);
+            a.t_s + ds_m / (0.5 * (a.speed_mps + b.speed_mps)).max(CRAWL_MPS)
+        };
     }
 }
 
@@ -231,17 +410,8 @@ fn cap_by_braking(path: &mut [PathPoint], speed_mps: f64, brake_mps2: f64, t0_s:
             lowered = true;
         }
     }
-    if !lowered {
-        return;
-    }
-    for k in 0..path.len() {
-        path[k].t_s = if k == 0 {
-            t0_s
-        } else {
-            let (a, b) = (&path[k - 1], &path[k]);
-            let ds_m = (b.x_m - a.x_m).hypot(b.y_m - a.y_m);
-            a.t_s + ds_m / (0.5 * (a.speed_mps + b.speed_mps)).max(CRAWL_MPS)
-        };
+    if lowered {
+        retime(path, t0_s);
     }
 }
 

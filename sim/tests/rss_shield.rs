@@ -89,6 +89,8 @@ fn the_shield_stops_a_blind_planner_from_running_into_the_car_ahead() {
 #[test]
 fn where_no_pair_is_ever_dangerous_the_shield_changes_nothing() {
     // Side by side in the two lanes at the same speed: 1.7 m apart side to side, 0.725 m safe.
+    // For 4 s: the lower lane's taper (from 160 m) stays beyond the reach of the edge check
+    // (the safe gap to a standing object at 20 m/s, 90.8 m, from at most 80 m).
     let specs = vec![
         common::spec("upper", 0.0, 20.0, Driver::planner("blind")),
         VehicleSpec {
@@ -96,8 +98,8 @@ fn where_no_pair_is_ever_dangerous_the_shield_changes_nothing() {
             ..common::spec("lower", 0.0, 20.0, Driver::planner("blind"))
         },
     ];
-    let without = run(&specs, ShieldKind::None, 5.0);
-    let with = run(&specs, ShieldKind::Rss, 5.0);
+    let without = run(&specs, ShieldKind::None, 4.0);
+    let with = run(&specs, ShieldKind::Rss, 4.0);
     assert!(interventions(&with).is_empty(), "{:?}", with.events);
     assert_eq!(
         with.safety.min_gap_m.map(f64::to_bits),
@@ -115,4 +117,31 @@ fn human_drivers_are_not_shielded() {
     // model, not a planner: no shield, no intervention.
     let outcome = run(&closing_in(Driver::Idm), ShieldKind::Rss, 3.0);
     assert!(interventions(&outcome).is_empty(), "{:?}", outcome.events);
+}
+
+#[test]
+fn a_blind_planner_heading_into_a_closing_lane_is_stopped_before_the_edge() {
+    // Alone in the lower lane, blind, at 20 m/s: without the shield it drives into the taper's
+    // edge; with it, the edge ahead is a standing object and the car stops short of it.
+    let specs = vec![VehicleSpec {
+        lane: Lane::Lower.into(),
+        ..common::spec("lower", 0.0, 20.0, Driver::planner("blind"))
+    }];
+    let without = run(&specs, ShieldKind::None, 15.0);
+    assert!(!without.safety.edge_contacts.is_empty());
+    let with = run(&specs, ShieldKind::Rss, 15.0);
+    assert!(
+        with.safety.edge_contacts.is_empty(),
+        "{:?}",
+        with.safety.edge_contacts
+    );
+    let events = interventions(&with);
+    assert!(
+        events
+            .iter()
+            .any(|e| e.to_string().contains("the road's edge ahead")),
+        "{events:?}"
+    );
+    let car = &with.vehicles[0];
+    assert!(car.final_speed_mps < 0.5, "{}", car.final_speed_mps);
 }

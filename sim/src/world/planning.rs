@@ -146,7 +146,10 @@ impl World {
                     let event = SimEvent::ShieldIntervened {
                         t_s,
                         vehicle: self.agents[index].spec.name.clone(),
-                        other: Self::name_of(&self.names(), intervention.other),
+                        other: match intervention.other {
+                            Some(id) => Self::name_of(&self.names(), id),
+                            None => "the road's edge ahead".to_string(),
+                        },
                         response: intervention.responses.name().to_string(),
                         lon_gap_m: intervention.lon_gap_m,
                         safe_lon_gap_m: intervention.safety.safe_lon_gap_m,
