@@ -4,10 +4,10 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 pip=(python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore)
-# Pinned: the versions the suite was written and checked against (2026-12-02).
+# Pinned: the versions the suite was written and checked against (2026-12-02; pettingzoo 2026-12-03).
 "${pip[@]}" "maturin==1.16.0" "numpy==2.4.6" "pandas==3.1.1" "gymnasium==1.4.0" "pytest==9.2.0" \
     "matplotlib==3.11.2" "scipy==1.17.1" "statsmodels==0.15.0" "pyarrow==26.0.1" \
-    "commonroad-io==2026.1" "commonroad-vehicle-models==3.0.2"
+    "commonroad-io==2026.1" "commonroad-vehicle-models==3.0.2" "pettingzoo==1.25.0"
 # No build isolation: the maturin just installed builds it (no second download).
 started=$SECONDS
 "${pip[@]}" --no-build-isolation .

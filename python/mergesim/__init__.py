@@ -9,6 +9,8 @@
 - :class:`MergeEnv` — a Gymnasium environment: the agent drives one vehicle through the
   simulator's tracker, the others run the scenario's planners (also registered as
   ``mergesim/Merge-v0``);
+- :func:`parallel_env` — a PettingZoo ``ParallelEnv`` in which several connected vehicles are
+  agents at once, with a cooperative reward (:class:`MergeParallelEnv`);
 - :func:`register_planner` — a planner written in Python (``plan(observation) -> decision``)
   under a name, usable wherever a planner name goes (``run``, ``sweep``, ``study``,
   ``MergeEnv``);
@@ -20,6 +22,7 @@ See python/README.md.
 
 from ._native import Road, ScenarioError, SimulationError, builtin_scenarios, planners
 from .env import MergeEnv, RewardWeights
+from .parallel import MergeParallelEnv, TeamRewardWeights, parallel_env
 from .planner import Planner, python_planners, register_planner, unregister_planner
 from .run import RunResult, run
 from .study import study
@@ -35,16 +38,19 @@ except Exception:  # not installed (e.g. imported from the source tree)
 __all__ = [
     "__version__",
     "MergeEnv",
+    "MergeParallelEnv",
     "Planner",
     "RewardWeights",
     "Road",
     "RunResult",
     "ScenarioError",
     "SimulationError",
+    "TeamRewardWeights",
     "builtin_scenarios",
     "never_as_infinity",
     "never_column",
     "paired_differences",
+    "parallel_env",
     "planners",
     "python_planners",
     "register_planner",

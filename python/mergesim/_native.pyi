@@ -79,9 +79,15 @@ class Road:
         """How far ahead the lane must be left (every way on ends closed); None if it goes on."""
 
 StepResult = Tuple[List[List[float]], bool, bool, Optional[str], Optional[str], float]
+AgentsStepResult = Tuple[
+    List[List[float]], List[bool], List[bool], Optional[str], Optional[str], float
+]
 
 class EnvCore:
-    """The simulation behind ``mergesim.MergeEnv``."""
+    """The simulation behind ``mergesim.MergeEnv`` (one agent) and ``mergesim.parallel_env``
+    (several). Agents: ``vehicle`` (one, any vehicle; None: ``ego`` or the first), ``agents``
+    (these, each connected and planner-driven) or ``connected_agents=True`` (every connected,
+    planner-driven vehicle); at most one of the three."""
 
     def __init__(
         self,
@@ -89,14 +95,27 @@ class EnvCore:
         params_json: Optional[str] = None,
         planner: Optional[str] = None,
         vehicle: Optional[str] = None,
+        agents: Optional[Sequence[str]] = None,
+        connected_agents: bool = False,
     ) -> None: ...
     def reset(self, seed: Optional[int] = None) -> List[List[float]]:
         """Starts an episode; returns every vehicle's state row (``state_columns``)."""
     def step(self, target_speed_mps: float, target_y_m: float) -> StepResult:
-        """One planning period: (states, hit a vehicle, hit a road edge, vehicle at the road's
-        end, simulation error, time s)."""
+        """One planning period, commanding the (first) agent: (states, hit a vehicle, hit a road
+        edge, vehicle at the road's end, simulation error, time s)."""
+    def step_agents(self, commands: Sequence[Tuple[float, float]]) -> AgentsStepResult:
+        """One planning period, one (target_speed_mps, target_y_m) per agent in agent order (a
+        handed-back agent's is ignored): (states, per agent hit a vehicle, per agent hit a road
+        edge, vehicle at the road's end, simulation error, time s)."""
+    def hand_back(self, agent: int) -> None:
+        """Agent ``agent``'s vehicle (its position in ``agent_indices``) is driven by its own
+        planner until the next reset."""
     @property
-    def agent_index(self) -> int: ...
+    def agent_index(self) -> int:
+        """The (first) agent's vehicle index."""
+    @property
+    def agent_indices(self) -> List[int]:
+        """The agents' vehicle indices, in agent order."""
     @property
     def vehicle_names(self) -> List[str]: ...
     @property
@@ -111,5 +130,9 @@ class EnvCore:
     def agent_target_speed_mps(self) -> float: ...
     @property
     def nominal_target_speed_mps(self) -> float: ...
+    @property
+    def agent_target_speeds_mps(self) -> List[float]: ...
+    @property
+    def nominal_target_speeds_mps(self) -> List[float]: ...
     @staticmethod
     def state_columns() -> List[str]: ...

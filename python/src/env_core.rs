@@ -1,8 +1,10 @@
-//! The native half of `mergesim.MergeEnv`: a `World` stepped one planning period at a time, the
-//! agent's vehicle driven by the [`External`] behaviour, the others by the scenario's drivers.
+//! The native half of `mergesim.MergeEnv` and `mergesim.parallel_env`: a `World` stepped one
+//! planning period at a time, each agent's vehicle driven by the [`External`] behaviour, the
+//! others by the scenario's drivers.
 //! Observation, reward and termination are computed in Python (`mergesim/env.py`) from the
 //! vehicles' states this returns.
 
+use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
 use mergesim_types::VehicleId;
@@ -11,8 +13,9 @@ use scenarios::scenario::Scenario;
 use sim::config::Driver;
 use sim::recording::Recorder;
 use sim::registry::BehaviourRegistry;
-use sim::{RunOptions, SimError, TickObserver, World};
+use sim::{RunOptions, SimError, World};
 
+use crate::env_agents::{self, AgentChoice, ContactWatch, Contacts, SharedContacts};
 use crate::errors::BindingError;
 use crate::external::{Command, EXTERNAL_PLANNER, External, SharedCommand};
 use crate::source;
@@ -30,38 +33,7 @@ pub(crate) const STATE_COLUMNS: [&str; 9] = [
     "accel_lat_mps2",
 ];
 
-/// Contacts of the agent's vehicle since the last look.
-#[derive(Clone, Copy, Debug, Default)]
-struct Contacts {
-    vehicle: bool,
-    road_edge: bool,
-}
-
-/// Watches the world's collision reports for the agent's vehicle.
-struct ContactWatch {
-    agent: VehicleId,
-    contacts: Arc<Mutex<Contacts>>,
-}
-
-impl TickObserver for ContactWatch {
-    fn on_collision(&mut self, ids: &[VehicleId]) {
-        if !ids.contains(&self.agent) {
-            return;
-        }
-        let mut contacts = self
-            .contacts
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        // A collision between vehicles names both; a road-edge contact names one vehicle.
-        if ids.len() >= 2 {
-            contacts.vehicle = true;
-        } else {
-            contacts.road_edge = true;
-        }
-    }
-}
-
-/// What one environment step did (returned to Python as a tuple).
+/// What one environment step did for a single agent (returned to Python as a tuple).
 type StepResult = (
     Vec<Vec<f64>>,
     bool,
@@ -71,21 +43,43 @@ type StepResult = (
     f64,
 );
 
-/// The simulation behind `mergesim.MergeEnv` (module doc). Not thread-safe: used from the thread
-/// that made it.
+/// What one environment step did for every agent: the states, per agent (in agent order)
+/// whether it collided with a vehicle and whether it touched a road edge, the vehicle whose front
+/// passed the road's end, a simulation error, the time (s).
+type AgentsStepResult = (
+    Vec<Vec<f64>>,
+    Vec<bool>,
+    Vec<bool>,
+    Option<String>,
+    Option<String>,
+    f64,
+);
+
+/// The simulation behind `mergesim.MergeEnv` and `mergesim.parallel_env` (module doc). Not
+/// thread-safe: used from the thread that made it.
 #[pyclass(unsendable, module = "mergesim._native")]
 pub(crate) struct EnvCore {
     scenario: Scenario,
     planner: Option<String>,
-    agent: usize,
-    command: SharedCommand,
-    contacts: Arc<Mutex<Contacts>>,
+    /// The agents' vehicle indices, in agent order.
+    agents: Vec<usize>,
+    /// Each agent's command, in agent order.
+    commands: Vec<SharedCommand>,
+    contacts: SharedContacts,
     registry: BehaviourRegistry,
     world: Option<World>,
     instance: Scenario,
 }
 
 impl EnvCore {
+    fn target_speeds_mps(scenario: &Scenario, agents: &[usize]) -> Vec<f64> {
+        agents
+            .iter()
+            .filter_map(|&i| scenario.vehicles.get(i))
+            .map(|v| v.target_speed_mps)
+            .collect()
+    }
+
     fn states(world: &World) -> Vec<Vec<f64>> {
         world
             .kinematics()
@@ -106,20 +100,87 @@ impl EnvCore {
             })
             .collect()
     }
+
+    fn lock_command(command: &SharedCommand) -> std::sync::MutexGuard<'_, Command> {
+        // A poisoned lock only means a panic elsewhere; the command itself is plain data.
+        command
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// Advances one planning period; (road end, error) as the step methods return them.
+    fn advance(world: &mut World, py: Python<'_>) -> (Option<String>, Option<String>) {
+        // Without the GIL: the world plans on a pool thread, where a Python planner (a
+        // neighbour's) takes the GIL for each of its cycles.
+        py.detach(|| {
+            for _ in 0..world.steps_per_plan() {
+                match world.step() {
+                    Ok(()) => {}
+                    Err(SimError::RoadEnd { vehicle, .. }) => return (Some(vehicle), None),
+                    Err(e) => return (None, Some(crate::errors::chain(&e))),
+                }
+            }
+            (None, None)
+        })
+    }
+
+    /// The contacts since the last look (and none from now on).
+    fn take_contacts(&self) -> Vec<Contacts> {
+        let mut contacts = self
+            .contacts
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        std::mem::replace(&mut *contacts, vec![Contacts::default(); self.agents.len()])
+    }
+
+    /// A checked command (speed in m/s, lateral position in m).
+    fn command_of(target_speed_mps: f64, target_y_m: f64) -> PyResult<Command> {
+        if !target_speed_mps.is_finite() || !target_y_m.is_finite() {
+            return Err(BindingError::Input(format!(
+                "action ({target_speed_mps}, {target_y_m}): must be finite"
+            ))
+            .into());
+        }
+        Ok(Command {
+            target_speed_mps: target_speed_mps.max(0.0),
+            target_y_m,
+            handed_back: false,
+        })
+    }
 }
 
 #[pymethods]
 impl EnvCore {
-    /// Loads the scenario (as `mergesim.run` does) and picks the agent's vehicle: `vehicle` by
-    /// name, or `ego` if there is one, else the first vehicle.
+    /// Loads the scenario (as `mergesim.run` does) and picks the agents' vehicles: with neither
+    /// `agents` nor `connected_agents`, one agent, `vehicle` by name, or `ego` if there is one,
+    /// else the first vehicle (`MergeEnv`); `agents`: these vehicles by name; `connected_agents`:
+    /// every connected, planner-driven vehicle. Several agents must each be connected and
+    /// planner-driven (the planner takes the vehicle back when its agent is done:
+    /// [`EnvCore::hand_back`]).
     #[new]
-    #[pyo3(signature = (scenario, params_json = None, planner = None, vehicle = None))]
+    #[pyo3(signature = (
+        scenario, params_json = None, planner = None, vehicle = None, agents = None,
+        connected_agents = false
+    ))]
     fn new(
         scenario: &str,
         params_json: Option<&str>,
         planner: Option<String>,
-        vehicle: Option<&str>,
+        vehicle: Option<String>,
+        agents: Option<Vec<String>>,
+        connected_agents: bool,
     ) -> PyResult<Self> {
+        let choice = match (vehicle, agents, connected_agents) {
+            (vehicle, None, false) => AgentChoice::One(vehicle),
+            (None, Some(list), false) => AgentChoice::Many(list),
+            (None, None, true) => AgentChoice::EveryConnected,
+            _ => {
+                return Err(BindingError::Input(
+                    "choose the agents one way: vehicle, agents or connected_agents".into(),
+                )
+                .into());
+            }
+        };
         let scenario = source::load(scenario, params_json)?;
         // The environment's observations, commands and rendering are those of the straight
         // merge road (x along it, y across it); a road of lanes is refused, not misread.
@@ -131,17 +192,7 @@ impl EnvCore {
             ))
             .into());
         }
-        let names: Vec<&str> = scenario.vehicles.iter().map(|v| v.name.as_str()).collect();
-        let agent = match vehicle {
-            Some(name) => names.iter().position(|n| *n == name).ok_or_else(|| {
-                BindingError::Input(format!(
-                    "vehicle {name:?}: not a vehicle of scenario {} ({})",
-                    scenario.name,
-                    names.join(", ")
-                ))
-            })?,
-            None => names.iter().position(|n| *n == "ego").unwrap_or(0),
-        };
+        let agents = env_agents::select(&scenario, &choice)?;
         // The built-in planners and the Python ones registered now.
         let registry = crate::py_planner::registry()?;
         // Checked as `merge_sim run --planner` checks it (the same message).
@@ -158,42 +209,85 @@ impl EnvCore {
         scenario
             .check_vehicle_models(&registry)
             .map_err(|e| BindingError::input(&e))?;
-        let command: SharedCommand = Arc::new(Mutex::new(Command {
-            target_speed_mps: scenario.vehicles[agent].target_speed_mps,
-            target_y_m: 0.0,
-        }));
+        let commands: Vec<SharedCommand> = agents
+            .iter()
+            .map(|&i| {
+                Arc::new(Mutex::new(Command {
+                    target_speed_mps: scenario.vehicles[i].target_speed_mps,
+                    target_y_m: 0.0,
+                    handed_back: false,
+                }))
+            })
+            .collect();
+        // Vehicle name → its command, and (several agents only) the planner it is handed back
+        // to: its own, or `planner` if given (the vehicle keeps its own parameters).
+        let by_name: BTreeMap<String, SharedCommand> = agents
+            .iter()
+            .zip(&commands)
+            .map(|(&i, c)| (scenario.vehicles[i].name.clone(), c.clone()))
+            .collect();
+        let hand_back_to: BTreeMap<String, Driver> = if matches!(choice, AgentChoice::One(_)) {
+            BTreeMap::new()
+        } else {
+            agents
+                .iter()
+                .map(|&i| {
+                    let spec = &scenario.vehicles[i];
+                    let mut driver = spec.driver.clone();
+                    if let (Some(planner), Driver::Planner { name, .. }) = (&planner, &mut driver) {
+                        name.clone_from(planner);
+                    }
+                    (spec.name.clone(), driver)
+                })
+                .collect()
+        };
+        let own_planners = registry.clone();
         let mut registry = registry;
-        let shared = command.clone();
         registry
             .register(
                 EXTERNAL_PLANNER,
-                Arc::new(move |_: &sim::registry::FactoryInput<'_>| {
-                    Ok(Box::new(External {
-                        command: shared.clone(),
-                    }) as Box<dyn mergesim_types::Behaviour>)
+                Arc::new(move |input: &sim::registry::FactoryInput<'_>| {
+                    let name = &input.spec.name;
+                    let command = by_name.get(name).cloned().ok_or_else(|| {
+                        SimError::InvalidScenario(format!(
+                            "vehicle {name}: planner {EXTERNAL_PLANNER:?} drives the \
+                             environment's agents only"
+                        ))
+                    })?;
+                    let fallback = match hand_back_to.get(name) {
+                        Some(driver) => {
+                            Some(env_agents::own_planner(&own_planners, input, driver)?)
+                        }
+                        None => None,
+                    };
+                    Ok(Box::new(External { command, fallback })
+                        as Box<dyn mergesim_types::Behaviour>)
                 }),
             )
             .map_err(|e| BindingError::input(&e))?;
+        let contacts: SharedContacts =
+            Arc::new(Mutex::new(vec![Contacts::default(); agents.len()]));
         Ok(Self {
             instance: scenario.clone(),
             scenario,
             planner,
-            agent,
-            command,
-            contacts: Arc::default(),
+            agents,
+            commands,
+            contacts,
             registry,
             world: None,
         })
     }
 
     /// Starts an episode on the instance drawn with `seed` (`Scenario::instantiate`, what
-    /// `merge_sim run --seed SEED` runs; `None`: the nominal scenario), the agent's vehicle
-    /// commanded to hold its lane centre at its target speed. Returns the vehicles' states.
+    /// `merge_sim run --seed SEED` runs; `None`: the nominal scenario), each agent's vehicle
+    /// commanded to hold its lane centre at its target speed (none handed back). Returns the
+    /// vehicles' states.
     #[pyo3(signature = (seed = None))]
     fn reset(&mut self, seed: Option<u64>) -> PyResult<Vec<Vec<f64>>> {
         let mut instance = self.scenario.instance(seed);
         for (index, spec) in instance.vehicles.iter_mut().enumerate() {
-            if index == self.agent {
+            if self.agents.contains(&index) {
                 spec.driver = Driver::planner(EXTERNAL_PLANNER);
             } else if let (Some(planner), Driver::Planner { name, .. }) =
                 (&self.planner, &mut spec.driver)
@@ -202,29 +296,27 @@ impl EnvCore {
                 name.clone_from(planner);
             }
         }
-        let agent_spec = &instance.vehicles[self.agent];
-        *self
-            .command
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner) = Command {
-            target_speed_mps: agent_spec.target_speed_mps,
-            target_y_m: instance.sim.road.lane_center_y_m(
-                agent_spec
-                    .lane
-                    .merge_lane()
-                    .unwrap_or(mergesim_types::Lane::Lower),
-            ) + agent_spec.y_offset_m,
-        };
-        *self
-            .contacts
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner) = Contacts::default();
+        for (&agent, command) in self.agents.iter().zip(&self.commands) {
+            let spec = &instance.vehicles[agent];
+            *Self::lock_command(command) = Command {
+                target_speed_mps: spec.target_speed_mps,
+                target_y_m: instance.sim.road.lane_center_y_m(
+                    spec.lane
+                        .merge_lane()
+                        .unwrap_or(mergesim_types::Lane::Lower),
+                ) + spec.y_offset_m,
+                handed_back: false,
+            };
+        }
+        self.take_contacts();
         let options = RunOptions {
             planner_override: None,
             seed: seed.unwrap_or(0),
             keep_time_series: false,
             profile: false,
         };
+        // The last episode's world goes first (a failed reset leaves none: step refuses).
+        self.world = None;
         let mut world = World::with_registry(
             instance.sim.clone(),
             &instance.vehicles,
@@ -238,7 +330,7 @@ impl EnvCore {
         // and vector environments do not oversubscribe the cores (`background`).
         world.plan_on(crate::background::fresh_pool(Some(1))?);
         world.add_observer(Box::new(ContactWatch {
-            agent: self.agent as VehicleId,
+            agents: self.agents.iter().map(|&i| i as VehicleId).collect(),
             contacts: self.contacts.clone(),
         }));
         let states = Self::states(&world);
@@ -247,69 +339,108 @@ impl EnvCore {
         Ok(states)
     }
 
-    /// Commands the agent's vehicle (speed in m/s, lateral position `target_y_m` in the road's
-    /// y) and advances one planning period. Returns (states, collided with a vehicle, hit a
-    /// road edge, the vehicle whose front passed the road's end, a simulation error, time s);
-    /// after either of the last two the episode is over.
+    /// Commands the (first) agent's vehicle (speed in m/s, lateral position `target_y_m` in
+    /// the road's y) and advances one planning period. Returns (states, collided with a vehicle,
+    /// hit a road edge, the vehicle whose front passed the road's end, a simulation error,
+    /// time s); after either of the last two the episode is over.
     fn step(
         &mut self,
         py: Python<'_>,
         target_speed_mps: f64,
         target_y_m: f64,
     ) -> PyResult<StepResult> {
-        let Some(world) = self.world.as_mut() else {
-            return Err(BindingError::Input("step before reset: call reset() first".into()).into());
-        };
-        if !target_speed_mps.is_finite() || !target_y_m.is_finite() {
-            return Err(BindingError::Input(format!(
-                "action ({target_speed_mps}, {target_y_m}): must be finite"
-            ))
-            .into());
-        }
-        *self
-            .command
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner) = Command {
-            target_speed_mps: target_speed_mps.max(0.0),
-            target_y_m,
-        };
-        // Without the GIL: the world plans on a pool thread, where a Python planner (a
-        // neighbour's) takes the GIL for each of its cycles.
-        let (road_end, error) = py.detach(|| {
-            for _ in 0..world.steps_per_plan() {
-                match world.step() {
-                    Ok(()) => {}
-                    Err(SimError::RoadEnd { vehicle, .. }) => return (Some(vehicle), None),
-                    Err(e) => return (None, Some(crate::errors::chain(&e))),
-                }
-            }
-            (None, None)
-        });
-        let states = Self::states(world);
-        let time_s = world.time_s();
-        if road_end.is_some() || error.is_some() {
-            self.world = None;
-        }
-        let contacts = std::mem::take(
-            &mut *self
-                .contacts
-                .lock()
-                .unwrap_or_else(std::sync::PoisonError::into_inner),
-        );
+        let (states, vehicle, edge, road_end, error, time_s) =
+            self.step_agents(py, vec![(target_speed_mps, target_y_m)])?;
         Ok((
             states,
-            contacts.vehicle,
-            contacts.road_edge,
+            vehicle.first().copied().unwrap_or(false),
+            edge.first().copied().unwrap_or(false),
             road_end,
             error,
             time_s,
         ))
     }
 
-    /// Index of the agent's vehicle.
+    /// Commands every agent's vehicle (`commands[i]` = (speed m/s, lateral position m in the
+    /// road's y) of agent `i`, in agent order; a handed-back agent's is ignored) and advances one
+    /// planning period. Returns (states, per agent: collided with a vehicle, per agent: touched
+    /// a road edge, the vehicle whose front passed the road's end, a simulation error, time s);
+    /// after either of the last two the episode is over.
+    fn step_agents(
+        &mut self,
+        py: Python<'_>,
+        commands: Vec<(f64, f64)>,
+    ) -> PyResult<AgentsStepResult> {
+        if self.world.is_none() {
+            return Err(BindingError::Input("step before reset: call reset() first".into()).into());
+        }
+        if commands.len() != self.agents.len() {
+            return Err(BindingError::Input(format!(
+                "{} commands for {} agents: one (target_speed_mps, target_y_m) per agent",
+                commands.len(),
+                self.agents.len()
+            ))
+            .into());
+        }
+        // All checked before any is applied.
+        let mut checked = Vec::with_capacity(commands.len());
+        for (&(speed_mps, y_m), shared) in commands.iter().zip(&self.commands) {
+            let handed_back = Self::lock_command(shared).handed_back;
+            checked.push(if handed_back {
+                None
+            } else {
+                Some(Self::command_of(speed_mps, y_m)?)
+            });
+        }
+        for (command, shared) in checked.into_iter().zip(&self.commands) {
+            if let Some(command) = command {
+                *Self::lock_command(shared) = command;
+            }
+        }
+        let Some(world) = self.world.as_mut() else {
+            return Err(BindingError::Input("step before reset: call reset() first".into()).into());
+        };
+        let (road_end, error) = Self::advance(world, py);
+        let states = Self::states(world);
+        let time_s = world.time_s();
+        if road_end.is_some() || error.is_some() {
+            self.world = None;
+        }
+        let contacts = self.take_contacts();
+        Ok((
+            states,
+            contacts.iter().map(|c| c.vehicle).collect(),
+            contacts.iter().map(|c| c.road_edge).collect(),
+            road_end,
+            error,
+            time_s,
+        ))
+    }
+
+    /// Hands agent `agent`'s vehicle (its position in `agent_indices`) back to its own planner
+    /// (the scenario's, or the `planner` given) until the next reset; several agents only.
+    fn hand_back(&mut self, agent: usize) -> PyResult<()> {
+        let Some(command) = self.commands.get(agent) else {
+            return Err(BindingError::Input(format!(
+                "agent {agent}: there are {} agents",
+                self.agents.len()
+            ))
+            .into());
+        };
+        Self::lock_command(command).handed_back = true;
+        Ok(())
+    }
+
+    /// Index of the (first) agent's vehicle.
     #[getter]
     fn agent_index(&self) -> usize {
-        self.agent
+        self.agents.first().copied().unwrap_or(0)
+    }
+
+    /// Indices of the agents' vehicles, in agent order.
+    #[getter]
+    fn agent_indices(&self) -> Vec<usize> {
+        self.agents.clone()
     }
 
     /// Vehicle names, in id order.
@@ -363,16 +494,34 @@ impl EnvCore {
         self.instance.sim.planner_period_s
     }
 
-    /// The agent vehicle's target speed in the current episode (m/s).
+    /// The (first) agent vehicle's target speed in the current episode (m/s).
     #[getter]
     fn agent_target_speed_mps(&self) -> f64 {
-        self.instance.vehicles[self.agent].target_speed_mps
+        self.agent_target_speeds_mps()
+            .first()
+            .copied()
+            .unwrap_or(0.0)
     }
 
-    /// The agent vehicle's target speed in the nominal scenario (m/s).
+    /// The (first) agent vehicle's target speed in the nominal scenario (m/s).
     #[getter]
     fn nominal_target_speed_mps(&self) -> f64 {
-        self.scenario.vehicles[self.agent].target_speed_mps
+        self.nominal_target_speeds_mps()
+            .first()
+            .copied()
+            .unwrap_or(0.0)
+    }
+
+    /// Each agent vehicle's target speed in the current episode (m/s), in agent order.
+    #[getter]
+    fn agent_target_speeds_mps(&self) -> Vec<f64> {
+        Self::target_speeds_mps(&self.instance, &self.agents)
+    }
+
+    /// Each agent vehicle's target speed in the nominal scenario (m/s), in agent order.
+    #[getter]
+    fn nominal_target_speeds_mps(&self) -> Vec<f64> {
+        Self::target_speeds_mps(&self.scenario, &self.agents)
     }
 
     /// Names of the columns of a state row.

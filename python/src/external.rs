@@ -1,6 +1,8 @@
 //! The agent's vehicle in the Gymnasium environment: an "external" behaviour whose decision is
 //! built from the last action (a target speed and a lateral position), which the simulator's
-//! own pure-pursuit / PID tracker then turns into steering and wheel torques.
+//! own pure-pursuit / PID tracker then turns into steering and wheel torques. In the multi-agent
+//! environment a finished agent's vehicle is handed back to its own planner (the scenario's),
+//! which then drives it until the episode ends.
 
 use std::sync::{Arc, Mutex};
 
@@ -28,6 +30,9 @@ pub(crate) struct Command {
     pub target_speed_mps: f64,
     /// Lateral position to drive at (m, the road's y).
     pub target_y_m: f64,
+    /// Whether the vehicle is handed back to its own planner ([`External::fallback`]): the
+    /// command is then ignored.
+    pub handed_back: bool,
 }
 
 /// The commanded path, shared between the environment (which writes the command) and the
@@ -38,6 +43,9 @@ pub(crate) type SharedCommand = Arc<Mutex<Command>>;
 pub(crate) struct External {
     /// The command it follows.
     pub command: SharedCommand,
+    /// The vehicle's own planner, which plans instead once the command is handed back (None:
+    /// the command is followed to the end).
+    pub fallback: Option<Box<dyn Behaviour>>,
 }
 
 /// The path of `command` from the vehicle at (`x_m`, `y_m`) at time `t_s`: straight ahead at
@@ -70,6 +78,11 @@ impl Behaviour for External {
             .command
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if command.handed_back
+            && let Some(planner) = self.fallback.as_mut()
+        {
+            return planner.plan(obs);
+        }
         let path = commanded_path(command, obs.ego.x_m, obs.ego.y_m, obs.time_s);
         // Shared like a planner's path, so connected PF-ISO vehicles see where it goes.
         Ok(Decision::follow_and_share(path, obs))

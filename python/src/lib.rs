@@ -7,6 +7,7 @@
 //! whose functions and classes `_native` registers.
 
 mod background;
+mod env_agents;
 mod env_core;
 mod errors;
 mod external;
