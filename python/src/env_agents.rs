@@ -36,6 +36,7 @@ fn not_candidate_because(spec: &VehicleSpec) -> String {
     let driver = match &spec.driver {
         Driver::Planner { .. } => None,
         Driver::Idm => Some("it is driven by IDM, not a planner"),
+        Driver::IdmMobil => Some("it is driven by IDM with MOBIL, not a planner"),
         Driver::LaneKeeping => Some("it is driven by lane keeping, not a planner"),
         Driver::Prescribed { .. } => Some("it has a prescribed speed profile, not a planner"),
     };

@@ -194,10 +194,9 @@ impl Agent {
         let behaviour = behaviour_of(config, spec, registry, planner_override, lanes)?;
         let tracker = Tracker::new(config.tracker.clone(), &params);
         let shield = match config.shield {
-            ShieldKind::Rss if behaviour.is_planner() => Some(RssShield::new(
-                config.rss.clone(),
-                config.planner_period_s,
-            )),
+            ShieldKind::Rss if behaviour.is_planner() => {
+                Some(RssShield::new(config.rss.clone(), config.planner_period_s))
+            }
             ShieldKind::Rss | ShieldKind::None => None,
         };
         Ok(Self {
