@@ -26,18 +26,10 @@ fn urgent_merge_with(driver: &str, extra: &str) -> String {
 
 /// `merge_sim run --scenario FILE --json FILE.json`, parsed.
 fn run_json(path: &std::path::Path) -> serde_json::Value {
-    let json = path.with_extension("json");
-    let out = merge_sim(&[
-        "run",
-        "--scenario",
-        path.to_str().unwrap(),
-        "--no-rrd",
-        "--quiet",
-        "--json",
-        json.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap()
+    common::run_summary(
+        &path.with_extension("json"),
+        &["--scenario", path.to_str().unwrap()],
+    )
 }
 
 /// The ego's lane-change events.

@@ -7,18 +7,7 @@ use common::{merge_sim, scratch, stderr};
 
 /// `merge_sim run` with `args` and `--json`, parsed.
 fn run_json(dir: &std::path::Path, name: &str, args: &[&str]) -> serde_json::Value {
-    let json = dir.join(format!("{name}.json"));
-    let mut all = vec![
-        "run",
-        "--no-rrd",
-        "--quiet",
-        "--json",
-        json.to_str().unwrap(),
-    ];
-    all.extend_from_slice(args);
-    let out = merge_sim(&all);
-    assert!(out.status.success(), "{}", stderr(&out));
-    serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap()
+    common::run_summary(&dir.join(format!("{name}.json")), args)
 }
 
 /// The built-in urgent merge's file with `extra` appended.

@@ -359,8 +359,9 @@ fn edge_ahead_m(path: &[PathPoint], lanes: &LaneRoad, need_m: f64, look_m: f64) 
 /// Step (m) of the look past a path's end for the road's edge.
 const EDGE_STEP_M: f64 = 1.0;
 
-/// Caps the path's speeds to stop `stop_m` along it, braking at `brake_mps2`, and times its
-/// points by the new speeds if any was lowered (as [`cap_by_braking`]).
+/// Caps the path's speeds to stop `stop_m` along it, braking at `brake_mps2`,
+/// v ≤ √(2 · brake · (stop − distance along)), and times its points by the new speeds if any
+/// was lowered.
 fn stop_before(path: &mut [PathPoint], stop_m: f64, brake_mps2: f64, t0_s: f64) {
     let mut along_m = 0.0;
     let mut lowered = false;
@@ -393,26 +394,11 @@ fn retime(path: &mut [PathPoint], t0_s: f64) {
     }
 }
 
-/// Caps the path's speeds by braking at `brake_mps2` from `speed_mps` at its start; if that
-/// lowers any, times its points by the new speeds from `t0_s` (a standing stretch gets the time
-/// of a crawl at [`CRAWL_MPS`]).
+/// Caps the path's speeds by braking at `brake_mps2` from `speed_mps` at its start: a stop
+/// ([`stop_before`]) where that braking ends, v₀² / (2 · brake) along the path.
 fn cap_by_braking(path: &mut [PathPoint], speed_mps: f64, brake_mps2: f64, t0_s: f64) {
-    let v0_sq = speed_mps.max(0.0).powi(2);
-    let mut along_m = 0.0;
-    let mut lowered = false;
-    for k in 0..path.len() {
-        if k > 0 {
-            along_m += (path[k].x_m - path[k - 1].x_m).hypot(path[k].y_m - path[k - 1].y_m);
-        }
-        let cap_mps = (v0_sq - 2.0 * brake_mps2 * along_m).max(0.0).sqrt();
-        if path[k].speed_mps > cap_mps {
-            path[k].speed_mps = cap_mps;
-            lowered = true;
-        }
-    }
-    if lowered {
-        retime(path, t0_s);
-    }
+    let v0_mps = speed_mps.max(0.0);
+    stop_before(path, v0_mps * v0_mps / (2.0 * brake_mps2), brake_mps2, t0_s);
 }
 
 /// The speed (m/s) that times a path's standing stretch after the shield stops it.

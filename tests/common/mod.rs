@@ -71,3 +71,14 @@ pub fn scratch(name: &str) -> PathBuf {
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
+
+/// `merge_sim run --no-rrd --quiet --json JSON ARGS…`: asserts that it succeeded and returns
+/// the summary it wrote to `json`.
+pub fn run_summary(json: &Path, args: &[&str]) -> serde_json::Value {
+    let json_arg = json.to_str().unwrap();
+    let mut all = vec!["run", "--no-rrd", "--quiet", "--json", json_arg];
+    all.extend_from_slice(args);
+    let out = merge_sim(&all);
+    assert!(out.status.success(), "{}", stderr(&out));
+    serde_json::from_slice(&std::fs::read(json).unwrap()).unwrap()
+}
