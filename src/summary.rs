@@ -62,6 +62,10 @@ pub struct RunSummary {
     /// RSS-dangerous, each an event below); 0 without a shield.
     #[serde(default)]
     pub shield_interventions: usize,
+    /// Throughput through the merge, merging before the lane's end, delay and speed loss
+    /// against free flow, and the safety figures per vehicle class (`sim::traffic_metrics`).
+    #[serde(default)]
+    pub traffic: sim::traffic_metrics::TrafficSummary,
     /// Per-vehicle metrics.
     pub vehicles: Vec<sim::metrics::VehicleMetricsSummary>,
     /// Planner counters and timing.
@@ -113,6 +117,7 @@ impl RunSummary {
                 .iter()
                 .filter(|e| matches!(e, sim::SimEvent::ShieldIntervened { .. }))
                 .count(),
+            traffic: outcome.traffic.clone(),
             vehicles: outcome.vehicles.clone(),
             planner_stats: outcome.planner_stats.clone(),
             goal_reached: outcome.goals.first().map(|g| g.reached),
@@ -187,6 +192,24 @@ impl RunSummary {
             if self.near_miss { "yes" } else { "no" },
             self.tet_s
         ));
+        let traffic = &self.traffic;
+        if traffic.section_lane.is_some() || traffic.merging > 0 {
+            out.push_str(&format!(
+                "traffic: {} through the merge ({} crossed)  merged before the lane end {}/{}  \
+                 mean delay {}\n",
+                traffic
+                    .throughput_vph
+                    .map(|q| format!("{q:.0} veh/h"))
+                    .unwrap_or_else(|| "- veh/h".into()),
+                traffic.crossings,
+                traffic.merged_before_lane_end,
+                traffic.merging,
+                traffic
+                    .mean_delay_s
+                    .map(|d| format!("{d:.2} s"))
+                    .unwrap_or_else(|| "-".into()),
+            ));
+        }
         if self.recorded_traffic.is_some()
             || self.collisions_caused_by_replay > 0
             || self.min_gap_to_recorded_m.is_some()

@@ -55,6 +55,20 @@ fn an_idm_mobil_ego_merges_in_the_urgent_merge_where_a_plain_idm_ego_hits_the_la
         plain["collisions"].as_u64().unwrap() > 0,
         "the plain IDM ego was expected to touch the edge: {plain}"
     );
+    // The traffic figures say the same: one merging vehicle, not merged before its lane ended.
+    let ego_traffic = |summary: &serde_json::Value| {
+        summary["traffic"]["vehicles"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|v| v["vehicle"] == "ego")
+            .cloned()
+            .unwrap()
+    };
+    assert_eq!(plain["traffic"]["merging"], 1, "{}", plain["traffic"]);
+    assert_eq!(plain["traffic"]["merged_before_lane_end"], 0);
+    assert_eq!(ego_traffic(&plain)["merged_before_lane_end"], false);
+    assert_eq!(ego_traffic(&plain)["class"], "idm");
     // With MOBIL it changes into the through lane, behind or ahead of the obstacle, untouched.
     let mobil = dir.join("mobil.toml");
     std::fs::write(&mobil, urgent_merge_with("\"idm-mobil\"", "")).unwrap();
@@ -62,6 +76,23 @@ fn an_idm_mobil_ego_merges_in_the_urgent_merge_where_a_plain_idm_ego_hits_the_la
     assert_eq!(summary["collisions"], 0, "{summary}");
     let changes = lane_changes_of_ego(&summary);
     assert!(!changes.is_empty(), "no lane change of the ego: {summary}");
+    let ego = ego_traffic(&summary);
+    assert_eq!(ego["class"], "idm-mobil");
+    assert_eq!(ego["merged_before_lane_end"], true, "{ego}");
+    assert_eq!(summary["traffic"]["merged_before_lane_end"], 1);
+    // It merged at the instant of its lane-change event (`t = 12.35 s: ego changed lanes …`).
+    let merged_at_s = ego["merged_at_s"].as_f64().unwrap();
+    let event_t_s: f64 = changes[0]
+        .trim_start_matches("t = ")
+        .split(' ')
+        .next()
+        .and_then(|t| t.parse().ok())
+        .unwrap();
+    assert!(
+        (merged_at_s - event_t_s).abs() < 0.006,
+        "{merged_at_s} vs {}",
+        changes[0]
+    );
     // It travelled the whole run (never stuck at the lane's end): more than 25 s × 10 m/s.
     let ego = summary["vehicles"]
         .as_array()

@@ -178,6 +178,21 @@ fn sharded_sweep_merges_into_exactly_the_unsharded_one_and_rows_replay() {
     for key in ["collisions", "near_miss", "min_ttc_s", "min_gap_m", "tet_s"] {
         assert_eq!(run[key], row[key], "{key}");
     }
+    assert_eq!(run["shield_interventions"], row["shield_interventions"]);
+    for key in [
+        "throughput_vph",
+        "merging",
+        "merged_before_lane_end",
+        "mean_delay_s",
+    ] {
+        let row_key = if key == "merging" {
+            "merging_vehicles"
+        } else {
+            key
+        };
+        assert_eq!(run["traffic"][key], row[row_key], "{key}");
+    }
+    assert!(row["throughput_vph"].as_f64().is_some_and(|q| q > 0.0));
     assert_eq!(run["planner_stats"]["fallbacks"], row["fallbacks"]);
     assert_eq!(run["planner_stats"]["plans"], row["plans"]);
     let vehicles = run["vehicles"].as_array().unwrap();

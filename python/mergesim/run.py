@@ -23,8 +23,10 @@ class RunResult:
             planner, params, seed as a ``"0x..."`` string or None, ``drawn`` (with a seed: the
             values it drew, by dotted name with units), duration_s, wall_time_s, collisions,
             collisions_caused_by_replay, min_gap_m, min_ttc_s, min_gap_to_recorded_m,
-            min_ttc_to_recorded_s, near_miss, tet_s, shield_interventions, vehicles,
-            planner_stats, events).
+            min_ttc_to_recorded_s, near_miss, tet_s, shield_interventions, traffic
+            (throughput through the merge, merging before the lane's end, delay and speed
+            loss against free flow, per vehicle and per class), vehicles, planner_stats,
+            events).
         time_series: One row per vehicle per logged instant (20 Hz by default), with the
             columns of ``merge_sim run --csv``.
     """

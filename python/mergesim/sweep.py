@@ -150,7 +150,9 @@ def sweep(
         scenario_fingerprint, params, planners (the sweep's, a tuple), sweep_seed, total_runs,
         instance, planner, seed, status, error (only if a run failed), ``drawn.<value>`` (what
         the instance drew), the run's figures (collisions, near_miss, min_ttc_s,
-        min_ttc_never, min_gap_m, min_gap_never, tet_s, peak_yaw_rate_radps, ...),
+        min_ttc_never, min_gap_m, min_gap_never, tet_s, peak_yaw_rate_radps, ...,
+        shield_interventions, throughput_vph, merging_vehicles, merged_before_lane_end,
+        mean_delay_s),
         ``<vehicle>.<figure>`` and wall_time_s. "Never" is NaN with its ``..._never`` flag
         True, as in the JSONL and the Parquet file (see :func:`rows_frame`).
 

@@ -58,6 +58,7 @@ pub(crate) mod run_log;
 pub mod safety;
 pub mod shield;
 pub mod spatial;
+pub mod traffic_metrics;
 pub mod v2v;
 pub mod vehicle_models;
 pub(crate) mod world;

@@ -133,6 +133,10 @@ pub struct RunOutcome {
     pub duration_s: f64,
     /// Exact safety results.
     pub safety: SafetySummary,
+    /// Throughput, merging, delay and the safety figures per vehicle class
+    /// (`crate::traffic_metrics`).
+    #[serde(default)]
+    pub traffic: crate::traffic_metrics::TrafficSummary,
     /// Per-vehicle metrics of the simulated vehicles, in vehicle order (recorded traffic has
     /// none, nor time-series rows).
     pub vehicles: Vec<VehicleMetricsSummary>,

@@ -29,6 +29,7 @@ use crate::recording_observer::RecordingObserver;
 use crate::registry::BehaviourRegistry;
 use crate::run_log::RunLog;
 use crate::safety::{BodyState, SafetyMonitor};
+use crate::traffic_metrics::TrafficMetrics;
 use crate::v2v::V2vBus;
 
 mod goals;
@@ -63,6 +64,8 @@ pub struct World {
     bus: V2vBus,
     safety: SafetyMonitor,
     run_log: RunLog,
+    /// The traffic figures (`crate::traffic_metrics`).
+    traffic: TrafficMetrics,
     /// The recorded traffic's boxes at each log instant, if the time series is kept.
     recorded_track: Option<Vec<crate::outcome::RecordedPose>>,
     recording: RecordingObserver,
@@ -164,6 +167,19 @@ impl World {
                     .with_paper_metrics(lanes.clone(), a.spec.target_speed_mps)
             })
             .collect();
+        let traffic = TrafficMetrics::new(
+            lanes.clone(),
+            agents
+                .iter()
+                .map(|a| {
+                    (
+                        a.spec.name.clone(),
+                        a.spec.driver.class(options.planner_override.as_deref()),
+                        a.spec.target_speed_mps,
+                    )
+                })
+                .collect(),
+        );
         let recording = RecordingObserver::new(recorder, &lanes)?;
         Ok(Self {
             steps_per_plan: steps_for(config.planner_period_s, dt_s),
@@ -178,6 +194,7 @@ impl World {
             bus,
             safety,
             run_log: RunLog::new(metrics, options.keep_time_series),
+            traffic,
             recorded_track: options.keep_time_series.then(Vec::new),
             recording,
             observers: Vec::new(),
@@ -405,6 +422,7 @@ impl World {
         }
         f(&mut self.planner_stats)?;
         f(&mut self.run_log)?;
+        f(&mut self.traffic)?;
         f(&mut self.recording)?;
         for observer in &mut self.observers {
             f(observer.as_mut())?;

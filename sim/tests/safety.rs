@@ -436,3 +436,29 @@ fn touching_within_the_tolerance_is_contact() {
         .unwrap();
     assert_eq!(r.new_collisions.len(), 1);
 }
+
+#[test]
+fn a_vehicle_exposed_to_two_pairs_at_once_counts_its_time_once() {
+    // B sits between A (behind, closing at 5 m/s) and C (ahead, which B closes on at 5 m/s);
+    // both gaps start at 4 m and then stay below TTC 1.5 s for the whole run. The run's TET and
+    // each pair's count every instant; so does B's own exposure, once, not twice.
+    let dt = 0.01;
+    let mut m = pair_monitor();
+    for k in 0..50 {
+        let t = k as f64 * dt;
+        let a = car(0, 20.0 * t, 5.25, 0.0, 20.0, 0.0);
+        let b = car(1, 8.0 + 15.0 * t, 5.25, 0.0, 15.0, 0.0);
+        let c = car(2, 16.0 + 10.0 * t, 5.25, 0.0, 10.0, 0.0);
+        m.check(t, &[a, b, c], dt).unwrap();
+    }
+    let s = m.summary();
+    assert!(s.collisions.is_empty());
+    assert!((s.tet_s - 0.5).abs() < 1e-9, "{}", s.tet_s);
+    let exposure: std::collections::BTreeMap<u32, f64> = s.vehicle_tet_s.iter().copied().collect();
+    for id in 0..3 {
+        assert!((exposure[&id] - 0.5).abs() < 1e-9, "{id}: {exposure:?}");
+    }
+    // Summed over the vehicles (Minderhoud & Bovy): three vehicles exposed for 0.5 s each.
+    let total: f64 = s.vehicle_tet_s.iter().map(|(_, t)| t).sum();
+    assert!((total - 1.5).abs() < 1e-9);
+}

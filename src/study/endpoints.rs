@@ -1,14 +1,26 @@
 //! The endpoints a study plan may name: figures of a run's JSON summary (`merge_sim run
 //! --json`), per vehicle (`<vehicle>.<figure>`, the paper's figures included) or of the run
-//! (`min_gap_m`, `min_ttc_s`, `tet_s`), each with the unit its name carries.
+//! (`min_gap_m`, `min_ttc_s`, `tet_s`, and the traffic figures of [`RUN_FIGURES`]), each with
+//! the unit its name carries.
 
 use serde_json::Value;
 use sim::metrics::{VehicleMetrics, VehicleMetricsSummary};
 
 use crate::summary::RunSummary;
 
-/// Run-level figures a plan may name (whole run: they are safety figures, not motion states).
-pub const RUN_FIGURES: [&str; 3] = ["min_gap_m", "min_ttc_s", "tet_s"];
+/// Run-level figures a plan may name (whole run: safety and traffic figures, not motion
+/// states). The traffic figures are `sim::traffic_metrics`'s: `throughput_vph` through the
+/// merge, `mean_delay_s` against free flow, `unmerged_vehicles` (vehicles of an ending lane
+/// that did not merge before it ended) and the safety shield's interventions.
+pub const RUN_FIGURES: [&str; 7] = [
+    "min_gap_m",
+    "min_ttc_s",
+    "tet_s",
+    "throughput_vph",
+    "mean_delay_s",
+    "unmerged_vehicles",
+    "shield_interventions",
+];
 
 /// Per-vehicle figures that are not endpoints (bookkeeping, not outcomes).
 const NOT_ENDPOINTS: [&str; 3] = [
@@ -54,7 +66,8 @@ pub fn vehicle_figures() -> Vec<String> {
 
 /// The SI unit a figure's name carries (`…_radps` → `rad/s`); `1` for counts.
 pub fn unit_of(figure: &str) -> &'static str {
-    const SUFFIXES: [(&str, &str); 7] = [
+    const SUFFIXES: [(&str, &str); 8] = [
+        ("_vph", "veh/h"),
         ("_radps", "rad/s"),
         ("_rad", "rad"),
         ("_mps3", "m/s^3"),
@@ -78,6 +91,7 @@ pub fn canonical_unit(text: &str) -> Option<&'static str> {
         "m/s^3" | "m/s³" | "m/s3" => "m/s^3",
         "m/s^2" | "m/s²" | "m/s2" => "m/s^2",
         "m/s" => "m/s",
+        "veh/h" | "vph" => "veh/h",
         "m" => "m",
         "s" => "s",
         "1" | "count" | "counts" => "1",
@@ -153,6 +167,16 @@ impl EndpointFigure {
                 "min_gap_m" => summary.min_gap_m,
                 "min_ttc_s" => summary.min_ttc_s,
                 "tet_s" => Some(summary.tet_s),
+                "throughput_vph" => summary.traffic.throughput_vph,
+                "mean_delay_s" => summary.traffic.mean_delay_s,
+                "unmerged_vehicles" => Some(f64::from(
+                    summary.traffic.merging
+                        - summary
+                            .traffic
+                            .merged_before_lane_end
+                            .min(summary.traffic.merging),
+                )),
+                "shield_interventions" => Some(summary.shield_interventions as f64),
                 _ => None,
             };
             return (value, value);
@@ -190,6 +214,8 @@ mod tests {
         assert_eq!(unit_of("path_length_m"), "m");
         assert_eq!(unit_of("slowing_onset_s"), "s");
         assert_eq!(unit_of("yaw_rate_sign_changes"), "1");
+        assert_eq!(unit_of("throughput_vph"), "veh/h");
+        assert_eq!(unit_of("unmerged_vehicles"), "1");
         assert_eq!(canonical_unit("m/s²"), Some("m/s^2"));
         assert_eq!(canonical_unit("deg/s"), None);
     }
@@ -201,6 +227,12 @@ mod tests {
         assert_eq!(e.vehicle.as_deref(), Some("obstacle"));
         assert!(EndpointFigure::parse("obstacle.merge_zone_rms_yaw_rate_radps", &vehicles).is_ok());
         assert!(EndpointFigure::parse("min_ttc_s", &vehicles).is_ok());
+        let throughput = EndpointFigure::parse("throughput_vph", &vehicles).unwrap();
+        assert_eq!(
+            (throughput.vehicle.as_ref(), throughput.unit()),
+            (None, "veh/h")
+        );
+        assert!(EndpointFigure::parse("unmerged_vehicles", &vehicles).is_ok());
         for bad in [
             "truck.max_abs_yaw_rate_radps",
             "ego.max_yaw",

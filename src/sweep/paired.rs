@@ -64,7 +64,7 @@ const LOWER: Option<BetterWhen> = Some(BetterWhen::Lower);
 const HIGHER: Option<BetterWhen> = Some(BetterWhen::Higher);
 
 /// The run-level figures compared.
-const RUN_FIGURES: [Figure<RunMetrics>; 8] = [
+const RUN_FIGURES: [Figure<RunMetrics>; 11] = [
     figure("collisions", LOWER, WhenNull::Skip, |m| {
         Some(m.collisions as f64)
     }),
@@ -83,6 +83,13 @@ const RUN_FIGURES: [Figure<RunMetrics>; 8] = [
     figure("min_speed_mps", HIGHER, WhenNull::Skip, |m| {
         Some(m.min_speed_mps)
     }),
+    figure("shield_interventions", LOWER, WhenNull::Skip, |m| {
+        Some(m.shield_interventions as f64)
+    }),
+    figure("throughput_vph", HIGHER, WhenNull::Skip, |m| {
+        m.throughput_vph
+    }),
+    figure("mean_delay_s", LOWER, WhenNull::Skip, |m| m.mean_delay_s),
 ];
 
 /// Each vehicle's figures compared: its motion and the paper's figures.

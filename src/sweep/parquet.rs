@@ -111,7 +111,7 @@ impl Column {
 }
 
 /// The run-level figures of a row (nulls of the same types for a failed run).
-fn run_cells(m: Option<&RunMetrics>) -> [(&'static str, Cell); 15] {
+fn run_cells(m: Option<&RunMetrics>) -> [(&'static str, Cell); 20] {
     let u = |f: fn(&RunMetrics) -> u64| Cell::U64(m.map(f));
     let f = |f: fn(&RunMetrics) -> f64| Cell::F64(m.map(f));
     [
@@ -136,6 +136,14 @@ fn run_cells(m: Option<&RunMetrics>) -> [(&'static str, Cell); 15] {
         ("fallbacks", u(|m| m.fallbacks)),
         ("degraded_plans", u(|m| m.degraded_plans)),
         ("plans", u(|m| m.plans)),
+        ("shield_interventions", u(|m| m.shield_interventions)),
+        (
+            "throughput_vph",
+            Cell::F64(m.and_then(|m| m.throughput_vph)),
+        ),
+        ("merging_vehicles", u(|m| m.merging_vehicles)),
+        ("merged_before_lane_end", u(|m| m.merged_before_lane_end)),
+        ("mean_delay_s", Cell::F64(m.and_then(|m| m.mean_delay_s))),
     ]
 }
 

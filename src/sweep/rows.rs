@@ -50,6 +50,22 @@ pub struct RunMetrics {
     pub degraded_plans: u64,
     /// Planner cycles.
     pub plans: u64,
+    /// Safety-shield interventions over the vehicles (`[sim] shield`; 0 without one).
+    #[serde(default)]
+    pub shield_interventions: u64,
+    /// Throughput through the merge (vehicles per hour, `sim::traffic_metrics`); `None` with
+    /// fewer than two vehicles crossing its section, or on a road without an ending lane.
+    #[serde(default)]
+    pub throughput_vph: Option<f64>,
+    /// Vehicles that started in an ending lane.
+    #[serde(default)]
+    pub merging_vehicles: u64,
+    /// Of them, those that merged before their lane ended.
+    #[serde(default)]
+    pub merged_before_lane_end: u64,
+    /// Mean delay against free flow over the vehicles (s).
+    #[serde(default)]
+    pub mean_delay_s: Option<f64>,
     /// The figures of a run on a CommonRoad road (`None` on any other road, and then not
     /// written): written flat beside the others, read back by [`RunRow`]'s reader.
     #[serde(skip)]
@@ -121,6 +137,11 @@ impl RunMetrics {
             fallbacks: summary.planner_stats.fallbacks,
             degraded_plans: summary.planner_stats.degraded_plans,
             plans: summary.planner_stats.plans,
+            shield_interventions: summary.shield_interventions as u64,
+            throughput_vph: summary.traffic.throughput_vph,
+            merging_vehicles: u64::from(summary.traffic.merging),
+            merged_before_lane_end: u64::from(summary.traffic.merged_before_lane_end),
+            mean_delay_s: summary.traffic.mean_delay_s,
             commonroad: CommonRoadFigures::of(summary),
         }
     }

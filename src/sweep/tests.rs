@@ -42,6 +42,11 @@ fn fake(seed: u64) -> Result<RunMetrics, RunFailure> {
         fallbacks: seed % 2,
         degraded_plans: 0,
         plans: 10,
+        shield_interventions: 0,
+        throughput_vph: None,
+        merging_vehicles: 0,
+        merged_before_lane_end: 0,
+        mean_delay_s: None,
         commonroad: None,
     })
 }

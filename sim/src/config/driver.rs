@@ -70,6 +70,19 @@ impl Driver {
         }
     }
 
+    /// The driver's class in the traffic figures (`crate::traffic_metrics`): the planner's
+    /// name (`planner_override` replacing it, as `--planner` does), or `prescribed`,
+    /// `lane-keeping`, `idm`, `idm-mobil`.
+    pub fn class(&self, planner_override: Option<&str>) -> String {
+        match self {
+            Self::Planner { name, .. } => planner_override.unwrap_or(name).to_string(),
+            Self::Prescribed { .. } => "prescribed".to_string(),
+            Self::LaneKeeping => "lane-keeping".to_string(),
+            Self::Idm => "idm".to_string(),
+            Self::IdmMobil => "idm-mobil".to_string(),
+        }
+    }
+
     /// The vehicle's own planner parameters, if any.
     pub fn params(&self) -> Option<&ParamsTable> {
         match self {

@@ -111,6 +111,11 @@ pub struct SafetySummary {
     pub near_miss: bool,
     /// Time during which at least one pair had TTC below the threshold (s).
     pub tet_s: f64,
+    /// Per vehicle that was ever exposed, in id order: `(id, time during which at least one of
+    /// its pairs had TTC below the threshold (s))`. Summed over vehicles this is the TET of
+    /// Minderhoud & Bovy (2001), which counts each exposed vehicle's time.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub vehicle_tet_s: Vec<(VehicleId, f64)>,
     /// Every road-edge contact episode, in time order.
     pub edge_contacts: Vec<EdgeContactEvent>,
     /// Per pair that was ever followed (`SafetyMonitor`'s module doc), in id order.

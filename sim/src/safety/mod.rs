@@ -207,6 +207,8 @@ pub struct SafetyMonitor {
     edge_contacts: Vec<EdgeContactEvent>,
     previous_t_s: Option<f64>,
     tet_s: f64,
+    /// Per vehicle: its time exposed to a TTC below the threshold (`SafetySummary::vehicle_tet_s`).
+    vehicle_tet_s: BTreeMap<VehicleId, f64>,
     checked_instants: u64,
     checked_duration_s: f64,
     ttc_not_converged: u64,
@@ -232,6 +234,7 @@ impl SafetyMonitor {
             edge_contacts: Vec::new(),
             previous_t_s: None,
             tet_s: 0.0,
+            vehicle_tet_s: BTreeMap::new(),
             checked_instants: 0,
             checked_duration_s: 0.0,
             ttc_not_converged: 0,
@@ -323,6 +326,7 @@ impl SafetyMonitor {
         {
             self.tet_s += dt_s;
         }
+        self.add_vehicle_exposure(dt_s);
         self.collisions
             .extend(self.report.new_collisions.iter().cloned());
         self.edge_contacts
@@ -331,6 +335,24 @@ impl SafetyMonitor {
         self.checked_instants += 1;
         self.checked_duration_s += dt_s;
         Ok(&self.report)
+    }
+
+    /// Adds `dt_s` to the exposure of every vehicle with at least one pair below the TTC
+    /// threshold at this instant (each vehicle once, however many of its pairs are).
+    fn add_vehicle_exposure(&mut self, dt_s: f64) {
+        let threshold_s = self.params.ttc_threshold_s;
+        let mut exposed: Vec<VehicleId> = self
+            .report
+            .pairs
+            .iter()
+            .filter(|p| p.ttc_s.is_some_and(|ttc| ttc < threshold_s))
+            .flat_map(|p| [p.id_a, p.id_b])
+            .collect();
+        exposed.sort_unstable();
+        exposed.dedup();
+        for id in exposed {
+            *self.vehicle_tet_s.entry(id).or_insert(0.0) += dt_s;
+        }
     }
 
     /// Whether the monitor follows a pair with these bounds at this instant (module doc).
@@ -446,6 +468,7 @@ impl SafetyMonitor {
             t_min_ttc_s: min_ttc.map(|(_, t)| t),
             near_miss: self.collisions.is_empty() && close_call(min_ttc_s, min_gap_m),
             tet_s: self.tet_s,
+            vehicle_tet_s: self.vehicle_tet_s.iter().map(|(&id, &t)| (id, t)).collect(),
             edge_contacts: self.edge_contacts.clone(),
             pairs,
             checked_instants: self.checked_instants,

@@ -54,6 +54,7 @@ impl World {
             .collect();
         let started = self.timing.then(Instant::now);
         self.run_log.on_log(t_s, &views)?;
+        self.traffic.on_log(t_s, &views)?;
         for observer in &mut self.observers {
             observer.on_log(t_s, &views)?;
         }
@@ -100,6 +101,7 @@ impl World {
                 min_ttc_s: safety.min_ttc_s,
             })?;
         }
+        let traffic = self.traffic.summary(&safety);
         let planner_stats = self.planner_stats.stats();
         let vehicles = self.run_log.summaries();
         let v2v = self.bus.stats();
@@ -109,6 +111,7 @@ impl World {
         Ok(RunOutcome {
             duration_s,
             safety,
+            traffic,
             vehicles,
             planner_stats,
             v2v,
