@@ -349,7 +349,18 @@ impl Scenario {
     ///    passing at both corners means every instance any seed can draw is valid.
     /// 4. Geometry over the whole box: a vehicle in the lower lane starts where that lane exists
     ///    (its front before `road.merge_end_x_m`), and no two vehicles can overlap at spawn.
+    ///
+    /// With `[traffic]`, the checks run on the nominal instance and on the densest
+    /// (`Scenario::check_densest_traffic`); an error about a generated vehicle names its
+    /// `[traffic.<stream>]` table.
     pub(crate) fn check(&self, origin: &str, text: Option<&str>) -> Result<(), ScenarioError> {
+        self.check_values(origin, text)
+            .map_err(|e| self.traffic_error(e, "nominal", self.vehicles.len(), origin, text))?;
+        self.check_densest_traffic(origin, text)
+    }
+
+    /// [`Scenario::check`] on the vehicles as they are.
+    fn check_values(&self, origin: &str, text: Option<&str>) -> Result<(), ScenarioError> {
         let at =
             |entry: Option<Vec<String>>| Line(text.zip(entry).and_then(|(t, p)| line_of(t, &p)));
         let sim_error = |e: SimError, prefix: &str, entry: Option<Vec<String>>| {
@@ -405,8 +416,7 @@ impl Scenario {
             sim_c.validate().map_err(corner_error)?;
             sim::config::validate_vehicles(&sim_c, &vehicles_c).map_err(corner_error)?;
         }
-        self.check_geometry(origin, &at)?;
-        self.check_densest_traffic(origin, text)
+        self.check_geometry(origin, &at)
     }
 
     /// The TOML path of a nominal field named as the simulator names it (`mu`,

@@ -129,31 +129,66 @@ impl Scenario {
             generated_vehicles: 0,
             ..self.clone()
         };
-        probe.check(origin, None).map_err(|e| {
-            let (field, message) = match e {
-                ScenarioError::Invalid { field, message, .. } => (field, message),
-                other => (None, other.to_string()),
-            };
-            // The stream whose vehicle the error names, else the first stream.
-            let stream = field
+        probe
+            .check_values(origin, None)
+            .map_err(|e| self.traffic_error(e, "densest", count, origin, text))
+    }
+
+    /// `e`, from checking an instance of `[traffic]` (`which`: `nominal` or `densest`, with
+    /// `count` vehicles), as an error of the stream whose generated vehicle it names (the line
+    /// of its table). Errors that name no generated vehicle pass unchanged, except for the
+    /// densest instance, which only the `[traffic]` tables make (the first stream is named).
+    pub(super) fn traffic_error(
+        &self,
+        e: ScenarioError,
+        which: &str,
+        count: usize,
+        origin: &str,
+        text: Option<&str>,
+    ) -> ScenarioError {
+        if self.traffic.is_empty() {
+            return e;
+        }
+        let generated = |name: &str| {
+            which == "densest"
+                || self.vehicles[self.fixed_vehicles().len()..]
+                    .iter()
+                    .any(|v| v.name == name)
+        };
+        let named = match &e {
+            ScenarioError::Invalid { field, .. } => field
                 .as_deref()
                 .and_then(|f| f.strip_prefix("vehicles["))
                 .and_then(|f| f.split_once(']'))
-                .and_then(|(name, _)| traffic::stream_of(&self.traffic, name))
-                .or_else(|| self.traffic.keys().next().map(String::as_str))
-                .unwrap_or_default()
-                .to_string();
-            let path = vec!["traffic".to_string(), stream.clone()];
-            ScenarioError::Invalid {
-                origin: origin.to_string(),
-                line: Line(text.and_then(|t| line_of(t, &path))),
-                field: Some(format!("traffic.{stream}")),
-                message: format!(
-                    "traffic.{stream}: the densest instance of [traffic] (every headway at \
-                     min_headway_s, {count} vehicles) is invalid: {message}"
-                ),
-            }
-        })
+                .map(|(name, _)| name.to_string()),
+            _ => None,
+        };
+        let stream = match &named {
+            Some(name) if generated(name) => traffic::stream_of(&self.traffic, name),
+            _ if which == "densest" => None,
+            _ => return e,
+        }
+        .or_else(|| self.traffic.keys().next().map(String::as_str))
+        .unwrap_or_default()
+        .to_string();
+        let message = match e {
+            ScenarioError::Invalid { message, .. } => message,
+            other => other.to_string(),
+        };
+        let what = match which {
+            "densest" => "every headway at min_headway_s",
+            _ => "centre flows, mean headways",
+        };
+        let path = vec!["traffic".to_string(), stream.clone()];
+        ScenarioError::Invalid {
+            origin: origin.to_string(),
+            line: Line(text.and_then(|t| line_of(t, &path))),
+            field: Some(format!("traffic.{stream}")),
+            message: format!(
+                "traffic.{stream}: the {which} instance of [traffic] ({what}, {count} vehicles) \
+                 is invalid: {message}"
+            ),
+        }
     }
 }
 
