@@ -62,6 +62,7 @@
 
 use std::collections::BTreeMap;
 
+use mergesim_types::bounds::Bound;
 use serde::{Deserialize, Serialize};
 use sim::config::{Driver, VehicleSpec};
 use sim::road_config::StartLane;
@@ -72,15 +73,23 @@ use crate::randomisation::{INSTANCE_STREAM, fnv1a64};
 /// Default smallest time headway `h₀` (s).
 pub const DEFAULT_MIN_HEADWAY_S: f64 = 1.0;
 
-/// Allowed range of `flow_vph` (veh/h, either bound).
-pub const FLOW_VPH_RANGE: [f64; 2] = [1.0, 10_000.0];
+/// Allowed ranges of a `[traffic.<stream>]` table's numbers: `flow_vph` (either end of its
+/// range), `speed_mps` (moving traffic: a headway is a spacing only at a speed above zero) and
+/// `min_headway_s`. `rear_x_m` and `front_x_m` are checked against the road through the
+/// vehicles they place.
+pub const TRAFFIC_BOUNDS: &[Bound] = &[
+    Bound::closed("flow_vph", 1.0, 10_000.0, "veh/h"),
+    Bound::closed("speed_mps", 1.0, 70.0, "m/s"),
+    Bound::closed("min_headway_s", 0.1, 60.0, "s"),
+];
 
-/// Allowed range of `min_headway_s` (s).
-pub const MIN_HEADWAY_S_RANGE: [f64; 2] = [0.1, 60.0];
-
-/// Allowed range of a stream's `speed_mps` (m/s): moving traffic (a headway is a spacing only
-/// at a speed above zero).
-pub const STREAM_SPEED_MPS_RANGE: [f64; 2] = [1.0, 70.0];
+/// The range of [`TRAFFIC_BOUNDS`] named `field`.
+fn range_of(field: &str) -> [f64; 2] {
+    TRAFFIC_BOUNDS
+        .iter()
+        .find(|b| b.field == field)
+        .map_or([f64::NAN, f64::NAN], |b| [b.min, b.max])
+}
 
 /// The `[traffic]` tables: streams by name.
 pub type Traffic = BTreeMap<String, TrafficStream>;
@@ -191,7 +200,7 @@ impl TrafficStream {
             );
         }
         let [lo, hi] = self.flow_vph.uniform;
-        let [min, max] = FLOW_VPH_RANGE;
+        let [min, max] = range_of("flow_vph");
         if !(lo.is_finite() && hi.is_finite() && min <= lo && lo <= hi && hi <= max) {
             return issue(
                 "flow_vph",
@@ -206,14 +215,14 @@ impl TrafficStream {
                 return issue("lanes", format!("lane {} is listed twice", lane_label(*a)));
             }
         }
-        let [min, max] = STREAM_SPEED_MPS_RANGE;
+        let [min, max] = range_of("speed_mps");
         if !(self.speed_mps.is_finite() && (min..=max).contains(&self.speed_mps)) {
             return issue(
                 "speed_mps",
                 format!("speed_mps = {}: allowed {min} to {max} m/s", self.speed_mps),
             );
         }
-        let [min, max] = MIN_HEADWAY_S_RANGE;
+        let [min, max] = range_of("min_headway_s");
         if !(self.min_headway_s.is_finite() && (min..=max).contains(&self.min_headway_s)) {
             return issue(
                 "min_headway_s",
@@ -396,7 +405,7 @@ pub(crate) fn same_lane(a: StartLane, b: StartLane) -> bool {
 }
 
 /// The stream whose generated vehicle is called `vehicle`, if any.
-pub(crate) fn stream_of<'a>(traffic: &'a Traffic, vehicle: &str) -> Option<&'a str> {
+pub fn stream_of<'a>(traffic: &'a Traffic, vehicle: &str) -> Option<&'a str> {
     traffic
         .keys()
         .filter(|name| {
