@@ -72,7 +72,11 @@ fn a_human_driver_stream_runs() {
     let file = dir.join("merge_flow_mobil.toml");
     std::fs::write(&file, &text).unwrap();
     let expanded = expand(&[file.to_str().unwrap()]);
-    assert_eq!(expanded.matches("driver = \"idm-mobil\"").count(), 8, "{expanded}");
+    assert_eq!(
+        expanded.matches("driver = \"idm-mobil\"").count(),
+        8,
+        "{expanded}"
+    );
     let summary = run_summary(
         &dir.join("out.json"),
         &["--scenario", file.to_str().unwrap(), "--duration", "2"],
@@ -99,7 +103,12 @@ fn bad_traffic_input_exits_2_naming_the_file_line_and_field() {
             "min_headway_s = 0.2",
         ),
         // Lane 7 does not exist on the on-ramp road.
-        ("lanes = [4]", "lanes = [7]", "traffic.ramp", "[traffic.ramp]"),
+        (
+            "lanes = [4]",
+            "lanes = [7]",
+            "traffic.ramp",
+            "[traffic.ramp]",
+        ),
         ("rear_x_m = 5.0", "rear_m = 5.0", "rear_m", "rear_m"),
     ] {
         let bad = text.replacen(from, to, 1);
@@ -126,4 +135,47 @@ fn bad_traffic_input_exits_2_naming_the_file_line_and_field() {
         let out = merge_sim(&["scenario", "expand", file.to_str().unwrap()]);
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     }
+}
+
+#[test]
+fn a_study_swaps_a_streams_driver_with_a_factor() {
+    // The dense-merging study's drivers: PF-ISO (the built-in's) against IDM + MOBIL human
+    // drivers, as a factor on the stream; every generated vehicle of the cell gets it.
+    let text = r#"name = "drivers"
+scenario = "merge_flow"
+planners = ["pf-sp", "pf-iso"]
+reference = "pf-sp"
+[instances]
+n = 2
+seed = 7
+[factors]
+"traffic.approach.driver" = ["idm-mobil", { planner = "pf-iso" }]
+[endpoints]
+primary = { figure = "min_gap_m", threshold = "0.5 m" }
+"#;
+    let plan = mergesim::study::plan::StudyPlan::from_text(text, std::path::Path::new("p.toml"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(plan.cells.len(), 2);
+    let drivers: Vec<Vec<sim::config::Driver>> = plan
+        .cells
+        .iter()
+        .map(|(_, s)| {
+            s.instantiate(3)
+                .vehicles
+                .iter()
+                .map(|v| v.driver.clone())
+                .collect()
+        })
+        .collect();
+    assert!(!drivers[0].is_empty());
+    assert!(
+        drivers[0]
+            .iter()
+            .all(|d| *d == sim::config::Driver::IdmMobil)
+    );
+    assert!(
+        drivers[1]
+            .iter()
+            .all(|d| *d == sim::config::Driver::planner("pf-iso"))
+    );
 }

@@ -542,8 +542,8 @@ mod geometry_checks;
 mod lane_road_checks;
 mod planner_tables;
 #[cfg(test)]
-mod traffic_tests;
+mod tests;
 mod traffic_checks;
 #[cfg(test)]
-mod tests;
+mod traffic_tests;
 mod vehicle_model_choice;

@@ -65,8 +65,8 @@ use std::collections::BTreeMap;
 use mergesim_types::bounds::Bound;
 use serde::{Deserialize, Serialize};
 use sim::config::{Driver, VehicleSpec};
-use sim::road_config::StartLane;
 use sim::rng::SplitMix64;
+use sim::road_config::StartLane;
 
 use crate::randomisation::{INSTANCE_STREAM, fnv1a64};
 
@@ -169,7 +169,7 @@ impl Default for TrafficStream {
 /// A `[traffic]` value that is wrong: its key under the stream and what is wrong.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct TrafficIssue {
-    /// Key under `traffic.<stream>` (`flow_vph`, …).
+    /// Key under `traffic.<stream>` (`flow_vph`, …); empty for the stream's name.
     pub key: &'static str,
     /// What is wrong.
     pub message: String,
@@ -195,7 +195,7 @@ impl TrafficStream {
                 .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
         {
             return issue(
-                "lanes",
+                "",
                 format!("stream name {name:?}: use letters, digits, '_' or '-'"),
             );
         }
@@ -204,7 +204,9 @@ impl TrafficStream {
         if !(lo.is_finite() && hi.is_finite() && min <= lo && lo <= hi && hi <= max) {
             return issue(
                 "flow_vph",
-                format!("flow_vph = {{ uniform = [{lo}, {hi}] }}: need {min} <= lo <= hi <= {max} veh/h"),
+                format!(
+                    "flow_vph = {{ uniform = [{lo}, {hi}] }}: need {min} <= lo <= hi <= {max} veh/h"
+                ),
             );
         }
         if self.lanes.is_empty() {

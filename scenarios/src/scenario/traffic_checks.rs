@@ -42,7 +42,11 @@ impl Scenario {
             }
         };
         let key_path = |stream: &str, key: &str| {
-            vec!["traffic".to_string(), stream.to_string(), key.to_string()]
+            let mut path = vec!["traffic".to_string(), stream.to_string()];
+            if !key.is_empty() {
+                path.push(key.to_string());
+            }
+            path
         };
         let mut densest_total = self.fixed_vehicles().len();
         for (name, stream) in &self.traffic {
@@ -84,8 +88,8 @@ impl Scenario {
                     ));
                 }
                 let margin_m = stream.speed_mps * stream.min_headway_s;
-                let in_window = (stream.rear_x_m - margin_m..=stream.front_x_m + margin_m)
-                    .contains(&v.x_m);
+                let in_window =
+                    (stream.rear_x_m - margin_m..=stream.front_x_m + margin_m).contains(&v.x_m);
                 if in_window && stream.lanes.iter().any(|l| traffic::same_lane(*l, v.lane)) {
                     return Err(error(
                         x_path,
@@ -196,9 +200,8 @@ impl Scenario {
 /// tables, not the vehicles those generate (which reading the text back generates again).
 impl Serialize for Scenario {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let fields = 5
-            + usize::from(!self.traffic.is_empty())
-            + usize::from(!self.randomise.is_empty());
+        let fields =
+            5 + usize::from(!self.traffic.is_empty()) + usize::from(!self.randomise.is_empty());
         let mut s = serializer.serialize_struct("Scenario", fields)?;
         s.serialize_field("name", &self.name)?;
         s.serialize_field("description", &self.description)?;

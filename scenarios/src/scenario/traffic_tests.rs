@@ -76,8 +76,11 @@ fn the_nominal_vehicles_follow_the_listed_ones_and_the_text_reads_back() {
     assert_eq!(s.vehicles.len(), 9);
     assert_eq!(s.vehicles[0].name, "ego");
     assert_eq!(s.vehicles[1].name, "approach_upper_00");
-    assert!(s.vehicles[1..].iter().all(|v| v.driver == sim::config::Driver::IdmMobil
-        && !v.connected));
+    assert!(
+        s.vehicles[1..]
+            .iter()
+            .all(|v| v.driver == sim::config::Driver::IdmMobil && !v.connected)
+    );
     // Written out: the listed vehicle and the [traffic] table, not the generated vehicles.
     let written = s.to_toml().unwrap();
     assert!(!written.contains("approach_upper_00"), "{written}");
@@ -92,8 +95,9 @@ fn instances_are_deterministic_vary_in_count_and_have_every_vehicle_listed() {
     assert_eq!(a, s.instantiate(3));
     assert!(a.traffic.is_empty() && a.generated_vehicles == 0);
     assert_eq!(a.vehicles[0].name, "ego");
-    let counts: std::collections::BTreeSet<usize> =
-        (0..40).map(|seed| s.instantiate(seed).vehicles.len()).collect();
+    let counts: std::collections::BTreeSet<usize> = (0..40)
+        .map(|seed| s.instantiate(seed).vehicles.len())
+        .collect();
     assert!(counts.len() > 2, "{counts:?}");
     // The instance is a scenario of its own: its text lists every vehicle and reads back.
     let written = a.to_toml().unwrap();
@@ -151,7 +155,12 @@ fn bad_traffic_values_name_the_file_line_and_field() {
             "min_headway_s",
         ),
         // The ego inside the window of its lane.
-        ("x_m = -20.0", "x_m = 100.0", "vehicles.0.x_m", "x_m = 100.0"),
+        (
+            "x_m = -20.0",
+            "x_m = 100.0",
+            "vehicles.0.x_m",
+            "x_m = 100.0",
+        ),
     ] {
         let bad = text.replacen(from, to, 1);
         assert_ne!(bad, text, "{from}");
@@ -162,7 +171,10 @@ fn bad_traffic_values_name_the_file_line_and_field() {
     }
     // 0.1 s headways in a 470 m window at 20 m/s: up to 236 per lane, more than allowed.
     let (_, _, message) = invalid(&text.replacen("min_headway_s = 1.0", "min_headway_s = 0.1", 1));
-    assert!(message.contains(&sim::config::MAX_VEHICLES.to_string()), "{message}");
+    assert!(
+        message.contains(&sim::config::MAX_VEHICLES.to_string()),
+        "{message}"
+    );
 }
 
 #[test]
@@ -221,6 +233,9 @@ fn the_built_in_flow_scenarios_load_with_their_documented_counts() {
     assert_eq!(merge.vehicles.len(), 8);
     for s in [&on_ramp, &merge] {
         assert!(s.fixed_vehicles().is_empty());
-        assert_eq!(Scenario::from_toml(&s.to_toml().unwrap(), "again").unwrap(), *s);
+        assert_eq!(
+            Scenario::from_toml(&s.to_toml().unwrap(), "again").unwrap(),
+            *s
+        );
     }
 }

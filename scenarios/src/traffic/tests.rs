@@ -82,7 +82,10 @@ fn headways_respect_the_minimum_and_cars_do_not_overlap() {
     let mut smallest_m = f64::INFINITY;
     for seed in 0..500 {
         for (lane, xs) in by_lane(&generate(&traffic, TrafficInstance::Seed(seed))) {
-            assert!(xs.iter().all(|x| (20.0..=620.0).contains(x)), "{lane}: {xs:?}");
+            assert!(
+                xs.iter().all(|x| (20.0..=620.0).contains(x)),
+                "{lane}: {xs:?}"
+            );
             for pair in xs.windows(2) {
                 let spacing_m = pair[0] - pair[1];
                 smallest_m = smallest_m.min(spacing_m);
