@@ -35,6 +35,7 @@ pub fn scenario_tables() -> Vec<(&'static str, &'static [Bound])> {
         ("sim.mobil", MOBIL_BOUNDS),
         ("sim.rss", RSS_BOUNDS),
         ("[vehicles]", VEHICLE_BOUNDS),
+        ("traffic.<stream>", scenarios::traffic::TRAFFIC_BOUNDS),
     ]
 }
 
@@ -141,6 +142,18 @@ pub fn other_limits() -> Vec<(String, String)> {
              every value the box can draw must satisfy the ranges above (checked at both \
              corners)"
                 .into(),
+        ),
+        (
+            "`[traffic.<stream>]`".into(),
+            format!(
+                "`flow_vph = {{ uniform = [lo, hi] }}`: exactly two numbers, lo ≤ hi; `lanes`: at \
+                 least one, none twice; `rear_x_m` < `front_x_m`; the mean headway at `hi`, \
+                 3600 · lanes / hi, at least `min_headway_s`; the densest instance (every \
+                 headway at `min_headway_s`) at most {MAX_VEHICLES} vehicles with the listed \
+                 ones, and valid like listed vehicles (on the road, no overlap, work per run); a \
+                 listed vehicle in a stream's lane outside its window widened by `speed_mps` × \
+                 `min_headway_s`, and not named `<stream>_…`"
+            ),
         ),
         (
             "work per run: vehicles × `duration_s` / `dt_s`".into(),

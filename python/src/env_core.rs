@@ -286,6 +286,21 @@ impl EnvCore {
     #[pyo3(signature = (seed = None))]
     fn reset(&mut self, seed: Option<u64>) -> PyResult<Vec<Vec<f64>>> {
         let mut instance = self.scenario.instance(seed);
+        // A scenario with `[traffic]` draws its generated vehicles per instance (their number
+        // varies): an agent must be one every instance has, at the same place.
+        for &agent in &self.agents {
+            let nominal = &self.scenario.vehicles[agent].name;
+            if instance.vehicles.get(agent).map(|v| &v.name) != Some(nominal) {
+                return Err(BindingError::Input(format!(
+                    "agent {nominal}: the instance drawn with seed {} has no such vehicle \
+                     (scenario {} generates its [traffic] vehicles per instance; an agent \
+                     must be a vehicle listed in [[vehicles]])",
+                    seed.unwrap_or(0),
+                    self.scenario.name
+                ))
+                .into());
+            }
+        }
         for (index, spec) in instance.vehicles.iter_mut().enumerate() {
             if self.agents.contains(&index) {
                 spec.driver = Driver::planner(EXTERNAL_PLANNER);

@@ -21,6 +21,8 @@ pub const BUILTINS: &[(&str, &str)] = &[
     ),
     ("curved_merge", include_str!("../builtin/curved_merge.toml")),
     ("on_ramp", include_str!("../builtin/on_ramp.toml")),
+    ("on_ramp_flow", include_str!("../builtin/on_ramp_flow.toml")),
+    ("merge_flow", include_str!("../builtin/merge_flow.toml")),
 ];
 
 /// Names of the built-in scenarios.

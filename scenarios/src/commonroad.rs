@@ -430,6 +430,8 @@ impl Scenario {
                 ..defaults
             },
             vehicles: vec![ego],
+            traffic: crate::traffic::Traffic::new(),
+            generated_vehicles: 0,
             randomise: crate::randomisation::Randomisation::default(),
             planner_overrides: toml::Table::new(),
             source: None,

@@ -43,7 +43,9 @@ pub struct NormalOffset {
 }
 
 /// Reads `[lo, hi]`: exactly two numbers (serde's arrays would silently ignore a third).
-fn exactly_two<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<[f64; 2], D::Error> {
+pub(crate) fn exactly_two<'de, D: serde::Deserializer<'de>>(
+    deserializer: D,
+) -> Result<[f64; 2], D::Error> {
     let values = Vec::<f64>::deserialize(deserializer)?;
     match values.as_slice() {
         [lo, hi] => Ok([*lo, *hi]),

@@ -12,6 +12,8 @@
 //!   field, [`source_location`]).
 //! - [`randomisation::Randomisation`] and [`randomisation::VehicleRandomisation`]: the ranges a
 //!   sweep draws instances from, as [`Distribution`]s ([`NormalOffset`]).
+//! - [`traffic::TrafficStream`]: the `[traffic]` tables, vehicles generated per instance from
+//!   traffic flows (shifted-exponential headways, placed at t = 0).
 //! - The built-in scenarios ([`builtin`]) and generated platoons ([`platoon`]); the scenario
 //!   module itself, [`scenario`], and the randomisation module, [`randomisation`].
 //!
@@ -29,5 +31,6 @@ pub mod platoon;
 pub mod randomisation;
 pub mod scenario;
 pub mod source_location;
+pub mod traffic;
 
 pub use distribution::{Distribution, NormalOffset};

@@ -316,6 +316,16 @@ pub(crate) enum ScenarioCommand {
         #[arg(long, value_name = "N")]
         vehicles: usize,
     },
+    /// Print the instance a scenario runs as TOML, every vehicle written out (those its
+    /// [traffic] generates included): the nominal one, or with --seed N the one `run --seed N`
+    /// draws.
+    Expand {
+        /// Built-in scenario name or path to a scenario TOML file.
+        scenario: String,
+        /// The instance drawn with seed N (decimal or 0x hex), as `run --seed N`.
+        #[arg(long, value_name = "N", value_parser = parse_seed)]
+        seed: Option<u64>,
+    },
 }
 
 /// Parses the process's arguments with the planners of `registry`: `--planner` / `--planners`

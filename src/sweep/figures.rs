@@ -14,14 +14,28 @@ use crate::summary::RunSummary;
 /// and per vehicle `vehicles.<name>.x_m`, `.y_offset_m`, `.speed_mps`, `.target_speed_mps`
 /// (a `cruise_speed_mps` entry moves both speeds). Each is the value the run used (nominal plus
 /// the drawn offset), in the unit its name carries; a value the scenario does not randomise is
-/// absent. Empty for a scenario without `[randomise]`.
+/// absent. A scenario with `[traffic]` adds, per stream, the flow it drew,
+/// `traffic.<stream>.flow_vph` (veh/h), and how many vehicles it generated,
+/// `traffic.<stream>.vehicles` (the per-vehicle values then vary in number between instances).
+/// Empty for a scenario without `[randomise]` or `[traffic]`.
 pub fn drawn_values(scenario: &Scenario, seed: u64) -> BTreeMap<String, f64> {
     let randomise = &scenario.randomise;
     let mut drawn = BTreeMap::new();
-    if randomise.is_empty() {
+    if randomise.is_empty() && scenario.traffic.is_empty() {
         return drawn;
     }
     let instance = scenario.instantiate(seed);
+    for (name, stream) in &scenario.traffic {
+        drawn.insert(
+            format!("traffic.{name}.flow_vph"),
+            stream.drawn_flow_vph(name, seed),
+        );
+        let count = instance.vehicles[scenario.fixed_vehicles().len()..]
+            .iter()
+            .filter(|v| scenarios::traffic::stream_of(&scenario.traffic, &v.name) == Some(name))
+            .count();
+        drawn.insert(format!("traffic.{name}.vehicles"), count as f64);
+    }
     let sim = [
         ("mu", instance.sim.mu),
         ("v2v.latency_s", instance.sim.v2v.latency_s),
@@ -48,10 +62,13 @@ pub fn drawn_values(scenario: &Scenario, seed: u64) -> BTreeMap<String, f64> {
     drawn
 }
 
-/// The unit of a drawn value, read off its name (names carry their unit): `m/s` for `_mps`,
+/// The unit of a drawn value, read off its name (names carry their unit): `veh/h` for `_vph`,
+/// `m/s` for `_mps`,
 /// `m` for `_m`, `s` for `_s`, nothing for `mu` and `drop_probability` (dimensionless).
 pub fn drawn_unit(name: &str) -> &'static str {
-    if name.ends_with("_mps") {
+    if name.ends_with("_vph") {
+        "veh/h"
+    } else if name.ends_with("_mps") {
         "m/s"
     } else if name.ends_with("_m") {
         "m"

@@ -287,8 +287,13 @@ fn has_path(table: &toml::Table, path: &[String]) -> bool {
             None => return false,
         }
     }
-    // A factor sets a value, not a whole table.
-    !matches!(current, None | Some(toml::Value::Table(_)))
+    // A factor sets a value, not a whole table; but a `driver` (a vehicle's, a `[traffic]`
+    // stream's) is one value whose planner form is a table (`{ planner = "pf-iso" }`).
+    match current {
+        None => false,
+        Some(toml::Value::Table(_)) => path.last().is_some_and(|key| key == "driver"),
+        Some(_) => true,
+    }
 }
 
 fn set_path(table: &mut toml::Table, path: &[String], value: toml::Value) {
