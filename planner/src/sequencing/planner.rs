@@ -40,6 +40,7 @@ use crate::error::PlannerError;
 use crate::params::PlannerParams;
 use crate::planner_kind::PlannerKind;
 use crate::planners::PfPlanner;
+use crate::stop_and_go::segment_time_s;
 
 /// Gravity (m/s²), for the friction limit of the braking bound.
 const GRAVITY_MPS2: f64 = 9.81;
@@ -263,59 +264,47 @@ impl SequencedPlanner {
             .zip(&unconstrained)
             .any(|(a, b)| a.speed_mps < b.speed_mps - 1e-9);
         self.state.sequenced = true;
-        Some(retime(
-            path,
-            &along,
-            &samples,
-            obs.time_s,
-            limits.min_speed_mps,
-        ))
+        Some(retime(path, &along, &samples, obs.time_s))
     }
 }
 
-/// Local time at which the profile has covered `s_m` (extrapolated at the last speed, at least
-/// `floor_mps`, past its end).
-fn time_at(samples: &[ProfileSample], s_m: f64, floor_mps: f64) -> f64 {
+/// Local time at which the profile has covered `s_m`, if it does.
+fn time_at(samples: &[ProfileSample], s_m: f64) -> Option<f64> {
     let k = samples.partition_point(|x| x.distance_m < s_m);
-    match (
-        k.checked_sub(1).and_then(|i| samples.get(i)),
-        samples.get(k),
-    ) {
-        (Some(a), Some(b)) => {
-            let ds = b.distance_m - a.distance_m;
-            if ds > 0.0 {
-                a.tau_s + (b.tau_s - a.tau_s) * (s_m - a.distance_m) / ds
-            } else {
-                b.tau_s
-            }
-        }
-        (None, Some(b)) => b.tau_s,
-        (Some(a), None) => a.tau_s + (s_m - a.distance_m) / a.speed_mps.max(floor_mps),
-        (None, None) => 0.0,
+    let b = samples.get(k)?;
+    match k.checked_sub(1).and_then(|i| samples.get(i)) {
+        Some(a) if b.distance_m > a.distance_m => Some(
+            a.tau_s + (b.tau_s - a.tau_s) * (s_m - a.distance_m) / (b.distance_m - a.distance_m),
+        ),
+        _ => Some(b.tau_s),
     }
 }
 
 /// `path` with the times and speeds of the profile (`PathPoint`'s convention: point k carries
-/// the speed of the segment ending at it, t_k = t_{k−1} + Δs_k / v_k).
+/// the speed of the segment ending at it, t_k = t_{k−1} + Δs_k / v_k). A point the profile
+/// reaches gets its time on the profile and the segment's mean speed; a point beyond what the
+/// profile covers (it stopped behind a car ahead, or ran out of steps) gets the profile's last
+/// speed, possibly 0, timed as the stop-and-go paths are (`stop_and_go::segment_time_s`: at
+/// least 1 cm/s in the time only).
 fn retime(
     path: &[PathPoint],
     along: &[f64],
     samples: &[ProfileSample],
     now_s: f64,
-    floor_mps: f64,
 ) -> Vec<PathPoint> {
+    let last_speed = samples.last().map_or(0.0, |s| s.speed_mps);
     let mut out: Vec<PathPoint> = Vec::with_capacity(path.len());
     for (k, p) in path.iter().enumerate() {
-        let t_s = now_s + time_at(samples, along[k], floor_mps);
-        let speed_mps = match out.last() {
-            None => samples.first().map_or(p.speed_mps, |s| s.speed_mps),
+        let (t_s, speed_mps) = match out.last() {
+            None => (now_s, samples.first().map_or(p.speed_mps, |s| s.speed_mps)),
             Some(prev) => {
-                let dt = t_s - prev.t_s;
                 let ds = along[k] - along[k - 1];
-                if dt > 0.0 && ds > 0.0 {
-                    ds / dt
-                } else {
-                    prev.speed_mps
+                match time_at(samples, along[k]) {
+                    Some(tau) if now_s + tau > prev.t_s && ds > 0.0 => {
+                        (now_s + tau, ds / (now_s + tau - prev.t_s))
+                    }
+                    Some(_) => (prev.t_s, prev.speed_mps),
+                    None => (prev.t_s + segment_time_s(ds, last_speed), last_speed),
                 }
             }
         };

@@ -37,11 +37,13 @@
 //! forward with step h ([`SequencingParams::profile_step_s`](super::SequencingParams)):
 //!
 //! ```text
-//!   v_des(τ) = min( max(v_opt(τ), v_min), v_max, (g(τ) − δ_safe) / ρ )     rear-end constraint
+//!   v_des    = min( max(v_opt(τ + h), v_min), v_max, (g(τ) + v_l h − δ_safe) / (ρ + h) )
 //!   v(τ + h) = min( max(v_des, v(τ) − b_max h), v(τ) + u_max h )           |u| bounds
+//!   p(τ + h) = p(τ) + h v(τ + h)
 //! ```
 //!
-//! g(τ) the predicted bumper gap to the car ahead in the same lane (which keeps its speed),
+//! g(τ) the predicted bumper gap to the car ahead in the same lane (which keeps its speed v_l;
+//! the third term is the rear-end constraint g ≥ δ_safe + ρ v written at the step's end),
 //! b_max the vehicle's braking limit (≥ u_max: the safety constraint may brake harder than the
 //! comfort bound). Past T the optimal profile holds its arrival speed (u(T) = 0).
 
@@ -192,7 +194,7 @@ pub fn constrained_profile(
         if s >= distance_m {
             break;
         }
-        let mut v_des = desired(tau, s)
+        let mut v_des = desired(tau + h, s)
             .max(limits.min_speed_mps)
             .min(limits.max_speed_mps);
         if let Some(l) = leader {
