@@ -37,13 +37,29 @@
 //! forward with step h ([`SequencingParams::profile_step_s`](super::SequencingParams)):
 //!
 //! ```text
-//!   v_des    = min( max(v_opt(τ + h), v_min), v_max, (g(τ) + v_l h − δ_safe) / (ρ + h) )
+//!   v_des    = min( max(v_opt(τ + h), v_min), v_max, v_safe )
 //!   v(τ + h) = min( max(v_des, v(τ) − b_max h), v(τ) + u_max h )           |u| bounds
 //!   p(τ + h) = p(τ) + h v(τ + h)
 //! ```
 //!
-//! g(τ) the predicted bumper gap to the car ahead in the same lane (which keeps its speed v_l;
-//! the third term is the rear-end constraint g ≥ δ_safe + ρ v written at the step's end),
+//! v_safe is the highest v = v(τ + h) meeting, with the gap g after the step, both forms of the
+//! rear-end constraint:
+//!
+//! ```text
+//!   g ≥ δ_safe + ρ v                                  the paper's time-gap form
+//!   g ≥ δ_safe + ρ v + v² / 2b_max − v_l² / 2b_max     its braking-distance form (Gipps 1981)
+//! ```
+//!
+//! The first alone does not keep a follower off a leader that brakes hard: at 15 m/s with ρ =
+//! 1 s it allows a 17 m gap to a standing car, which takes 14 m of braking at 8 m/s² after the
+//! reaction (measured on `platoon_merge_50`, where cars in the zone stop behind the queue:
+//! rear-end contacts with the first form alone, docs/parameters.md). The second assumes the
+//! leader brakes no harder than b_max.
+//!
+//! ```text
+//! ```
+//!
+//! g(τ) the predicted bumper gap to the car ahead in the same lane (which keeps its speed v_l),
 //! b_max the vehicle's braking limit (≥ u_max: the safety constraint may brake harder than the
 //! comfort bound). Past T the optimal profile holds its arrival speed (u(T) = 0).
 
@@ -171,6 +187,27 @@ pub struct ProfileSample {
     pub speed_mps: f64,
 }
 
+/// The highest speed at the end of the next step that keeps both forms of the rear-end
+/// constraint (module doc) behind `leader`, having covered `s_m` at local time `tau_s`.
+fn safe_speed_mps(limits: &ProfileLimits, leader: &Leader, tau_s: f64, s_m: f64) -> f64 {
+    let h = limits.step_s;
+    let rho = limits.reaction_time_s;
+    let b = limits.max_brake_mps2;
+    // Gap after the step, driven at v: g(τ) + v_l h − v h.
+    let room_m = leader.gap_m + leader.speed_mps * (tau_s + h) - s_m - limits.standstill_gap_m;
+    // g ≥ δ_safe + ρ v  ⇔  v ≤ (room) / (ρ + h).
+    let time_gap_form = room_m / (rho + h);
+    // g ≥ δ_safe + ρ v + v²/2b − v_l²/2b  ⇔  v²/2b + (ρ + h) v − (room + v_l²/2b) ≤ 0.
+    let reach = room_m + leader.speed_mps * leader.speed_mps / (2.0 * b);
+    let braking_form = if reach <= 0.0 {
+        0.0
+    } else {
+        let t = rho + h;
+        b * (-t + (t * t + 2.0 * reach / b).sqrt())
+    };
+    time_gap_form.min(braking_form).max(0.0)
+}
+
 /// The constrained profile (module doc) from speed `v0_mps`, integrated until `distance_m`
 /// is covered or `max_steps` steps are taken. `desired(τ, s)` is the unconstrained speed wanted
 /// at local time τ having covered s (the energy-optimal profile's speed, or another target
@@ -198,12 +235,7 @@ pub fn constrained_profile(
             .max(limits.min_speed_mps)
             .min(limits.max_speed_mps);
         if let Some(l) = leader {
-            // Gap after this step if we drive at v_des: keep gap ≥ δ_safe + ρ v.
-            let gap_now = l.gap_m + l.speed_mps * tau - s;
-            let v_safe = ((gap_now + l.speed_mps * h - limits.standstill_gap_m)
-                / (limits.reaction_time_s + h))
-                .max(0.0);
-            v_des = v_des.min(v_safe);
+            v_des = v_des.min(safe_speed_mps(limits, &l, tau, s));
         }
         let v_next = v_des
             .max(v - limits.max_brake_mps2 * h)
@@ -290,6 +322,33 @@ mod tests {
         assert!(v_top <= 20.0 + TOL, "{v_top}");
         // Far from the bound it follows the optimum.
         assert!((samples[1].speed_mps - p.speed_mps(0.01)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn it_stops_behind_a_standing_car_keeping_both_forms() {
+        // From 20 m/s, a standing car 60 m ahead (both forms met: 60 ≥ 2 + 20 + 25). The
+        // time-gap form alone would let it drive on at 20 m/s until the gap is 23 m, then ask
+        // for 20 m/s² of braking (b_max = 8).
+        let leader = Leader {
+            gap_m: 60.0,
+            speed_mps: 0.0,
+        };
+        let l = limits();
+        let samples = constrained_profile(20.0, &l, Some(leader), 300.0, 3000, &|_, _| 20.0);
+        for s in &samples {
+            let gap = leader.gap_m - s.distance_m;
+            let need = l.standstill_gap_m
+                + l.reaction_time_s * s.speed_mps
+                + s.speed_mps * s.speed_mps / (2.0 * l.max_brake_mps2);
+            assert!(
+                gap >= need - 1e-6,
+                "τ {} gap {gap} v {}",
+                s.tau_s,
+                s.speed_mps
+            );
+        }
+        let last = samples.last().map_or(f64::NAN, |s| s.speed_mps);
+        assert!(last.abs() < 1e-6, "{last}");
     }
 
     #[test]
