@@ -71,6 +71,37 @@ fn a_dense_merge_with_sequencing_has_no_collision() {
 }
 
 #[test]
+fn with_lost_late_and_duplicated_messages_the_dense_merge_stays_clean() {
+    // 30 % of the messages lost, 0.1 s latency, 20 % duplicated; a randomised instance (seed 1).
+    let dir = scratch("merge_sequencing_faults");
+    let file = dir.join("faults.toml");
+    std::fs::write(
+        &file,
+        dense_merge_with(
+            "",
+        )
+        .replace(
+            "[randomise]\n",
+            "[sim.v2v]\ndrop_probability = 0.3\nlatency_s = 0.1\nduplicate_probability = 0.2\n\n[randomise]\n",
+        ),
+    )
+    .unwrap();
+    let summary = run_json(
+        &dir,
+        "faults",
+        &[
+            "--scenario",
+            file.to_str().unwrap(),
+            "--planner",
+            "pf-iso-seq",
+            "--seed",
+            "1",
+        ],
+    );
+    assert_sequenced_merge_is_clean(&summary);
+}
+
+#[test]
 fn the_parameter_table_is_read_and_a_bad_value_is_refused_naming_file_line_and_field() {
     let dir = scratch("merge_sequencing_params");
     let good = dir.join("good.toml");
