@@ -9,6 +9,7 @@ use mergesim_types::bounds::{Bound, markdown_rows};
 use mergesim_types::lanes::{CURVED_MERGE_RADIUS_M, ON_RAMP_BOUNDS};
 use mergesim_types::{MERGE_SECTION_LENGTH_M, ROAD_BOUNDS};
 use planner::params::{MAX_WAYPOINTS, MIN_WAYPOINTS, PLANNER_BOUNDS};
+use planner::sequencing::SEQUENCING_BOUNDS;
 use scenarios::scenario::ROAD_END_SPEED_ALLOWANCE;
 use sim::config::{
     MAX_PAIR_CHECKS, MAX_PLANNING_CYCLES, MAX_VEHICLE_STEPS, MAX_VEHICLES, SIM_BOUNDS,
@@ -28,6 +29,7 @@ pub fn scenario_tables() -> Vec<(&'static str, &'static [Bound])> {
         ("sim.road", ROAD_BOUNDS),
         ("sim.lane_road.on_ramp", ON_RAMP_BOUNDS),
         ("sim.planner", PLANNER_BOUNDS),
+        ("sim.planners.pf-iso-seq", SEQUENCING_BOUNDS),
         ("sim.tracker", TRACKER_BOUNDS),
         ("sim.safety", SAFETY_BOUNDS),
         ("sim.v2v", V2V_BOUNDS),

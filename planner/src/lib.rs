@@ -55,6 +55,7 @@ pub mod potential_field;
 pub(crate) mod prediction;
 pub(crate) mod request;
 pub mod road_field;
+pub mod sequencing;
 pub mod speed_optimisation;
 pub mod speed_profile;
 pub(crate) mod stop_and_go;

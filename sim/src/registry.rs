@@ -2,7 +2,8 @@
 //! and a prescribed-speed driver's `path_planner` are looked up in.
 //!
 //! [`BehaviourRegistry::builtin`] holds the paper's planners (`pf-cs`, `pf-sp`, `pf-sp-eq10`,
-//! `pf-iso`, `pf-iso-pred`). A user adds their own without editing any crate:
+//! `pf-iso`, `pf-iso-pred`) and merge sequencing `pf-iso-seq` (`planner::sequencing`, its
+//! parameters `[sim.planners.pf-iso-seq]`). A user adds their own without editing any crate:
 //!
 //! ```
 //! use std::sync::Arc;
@@ -79,6 +80,7 @@ use std::sync::Arc;
 
 use planner::params::PlannerParams;
 use planner::params_tables::{self, PF_TABLES};
+use planner::sequencing::{SEQUENCED_PLANNER_NAME, SequencedPlanner, SequencingParams};
 use planner::{PfPlanner, PlannerKind};
 
 use crate::config::{SimConfig, VehicleSpec};
@@ -210,7 +212,8 @@ impl BehaviourRegistry {
         self.vehicle_models.register(name, description, factory)
     }
 
-    /// The paper's planners under their names (`PlannerKind::name`).
+    /// The paper's planners under their names (`PlannerKind::name`), and merge sequencing
+    /// (`pf-iso-seq`, with its own parameter type).
     pub fn builtin() -> Self {
         let mut registry = Self::new();
         for kind in PlannerKind::ALL {
@@ -221,6 +224,33 @@ impl BehaviourRegistry {
                 .schemas
                 .insert(kind.name().to_string(), Schema::Pf(kind));
         }
+        let sequenced: BehaviourFactory = Arc::new(|input: &FactoryInput<'_>| {
+            let params = input
+                .params_as::<SequencingParams>()
+                .cloned()
+                .unwrap_or_default();
+            SequencedPlanner::new(
+                input.config.planner.clone(),
+                params,
+                Arc::clone(input.lanes),
+            )
+            .map(|p| match &input.spec.route {
+                Some(route) => p.with_inner(|inner| inner.with_route(route)),
+                None => p,
+            })
+            .map(|p| Box::new(p) as Box<dyn Behaviour>)
+            .map_err(|source| SimError::Planner {
+                vehicle: input.spec.name.clone(),
+                source,
+            })
+        });
+        registry
+            .factories
+            .insert(SEQUENCED_PLANNER_NAME.to_string(), sequenced);
+        registry.schemas.insert(
+            SEQUENCED_PLANNER_NAME.to_string(),
+            Schema::Typed(Arc::new(parse_typed::<SequencingParams>)),
+        );
         registry
     }
 
@@ -385,6 +415,15 @@ impl BehaviourRegistry {
     }
 }
 
+impl PlannerParameters for SequencingParams {
+    fn validate(&self) -> Result<(), ParamsError> {
+        SequencingParams::validate(self).map_err(|e| ParamsError {
+            key: e.invalid_parameter().map(|p| p.name.clone()),
+            message: e.to_string(),
+        })
+    }
+}
+
 /// `base` with the values of `keys` on top, validated; the error names the key.
 pub fn pf_params_with(
     base: &PlannerParams,
@@ -429,6 +468,7 @@ mod tests {
     fn builtin_names_are_the_planner_kinds_and_duplicates_are_refused() {
         let mut registry = BehaviourRegistry::builtin();
         let mut expected: Vec<&str> = PlannerKind::ALL.iter().map(|k| k.name()).collect();
+        expected.push(SEQUENCED_PLANNER_NAME);
         expected.sort_unstable();
         assert_eq!(registry.names(), expected);
         let factory = pf_factory(PlannerKind::PfCs);
