@@ -164,3 +164,63 @@ fn the_mobil_table_is_read_and_checked() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("idm-mobil"), "{err}");
 }
+
+/// The built-in scenario `name` as `merge_sim scenario show` prints it, with every
+/// `driver = { planner = "pf-iso" }` line (a vehicle's or a traffic stream's) replaced by
+/// `driver = "idm-mobil"` and `connected = false`, written to `path`.
+fn all_idm_mobil(name: &str, path: &std::path::Path) {
+    let out = merge_sim(&["scenario", "show", name]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let pf_iso = "driver = { planner = \"pf-iso\" }";
+    assert!(text.contains(pf_iso), "{text}");
+    std::fs::write(
+        path,
+        text.replace(pf_iso, "driver = \"idm-mobil\"\nconnected = false"),
+    )
+    .unwrap();
+}
+
+#[test]
+fn on_the_on_ramp_an_idm_mobil_driver_leaves_the_acceleration_lane_and_no_main_road_car_enters_it()
+{
+    let dir = scratch("idm_mobil_on_ramp");
+    // From the ramp the driver follows its lane into the acceleration lane and then sees the
+    // main road beside it: it merges before the lane ends, untouched (it used to hold the
+    // ramp, which has no neighbour, and ran into the acceleration lane's end).
+    let path = dir.join("on_ramp.toml");
+    all_idm_mobil("on_ramp", &path);
+    let summary = run_json(&path);
+    assert_eq!(summary["collisions"], 0, "{}", summary["events"]);
+    assert_eq!(summary["traffic"]["merging"], 1);
+    assert_eq!(summary["traffic"]["merged_before_lane_end"], 1);
+    // Dense on-ramp traffic: the main road's drivers never change into the acceleration lane
+    // (lane 3: it ends ahead, theirs does not), nor into a lane that is not beside them yet,
+    // and none of them touches an edge.
+    let path = dir.join("on_ramp_flow.toml");
+    all_idm_mobil("on_ramp_flow", &path);
+    let summary = run_json(&path);
+    let events: Vec<&str> = summary["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|e| e.as_str())
+        .collect();
+    assert!(
+        !events
+            .iter()
+            .any(|e| e.contains(": main_") && (e.contains("to lane 3") || e.contains("to lane 4"))),
+        "{events:?}"
+    );
+    assert!(
+        !events
+            .iter()
+            .any(|e| e.contains("vehicle main_") && e.contains("road edge")),
+        "{events:?}"
+    );
+    let traffic = &summary["traffic"];
+    assert_eq!(
+        traffic["merged_before_lane_end"], traffic["merging"],
+        "{traffic}"
+    );
+}

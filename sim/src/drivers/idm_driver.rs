@@ -8,7 +8,10 @@
 //! both criteria. A lane that ends closed ahead (`LaneRoad::distance_to_closed_end_m`) is then
 //! a standing obstacle at its end, in the driver's own car following too, so the driver stops
 //! before it if no gap opens. A neighbour's desired speed cannot be observed: MOBIL takes it as
-//! the neighbour's current speed.
+//! the neighbour's current speed. A MOBIL driver holds the successor of its lane once past the
+//! lane's end (a ramp leading into an acceleration lane), so that it sees that lane's neighbours.
+//! A neighbour is a target only where it exists beside the car, and a lane that ends closed
+//! ahead only for a car whose own lane ends too.
 
 use mergesim_types::lanes::{Lane, LaneId, LaneRoad, Side};
 use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
@@ -142,6 +145,33 @@ fn around(
 }
 
 impl IdmDriver {
+    /// Holds the successor of the held lane once the car is past the lane's end (the one
+    /// whose centreline is nearest the car, if it has several), so that MOBIL looks at the
+    /// neighbours of the lane the car is in: a ramp has none, the acceleration lane it leads
+    /// into has the main road beside it. Bounded by the number of lanes.
+    fn follow_into_successor(&mut self, lanes: &LaneRoad, p_m: [f64; 2]) {
+        for _ in 0..lanes.lanes().len() {
+            let Some(held) = lanes.lane(self.lane) else {
+                return;
+            };
+            if held.project(p_m).s_m <= held.length_m() {
+                return;
+            }
+            let next = held
+                .successors()
+                .iter()
+                .filter_map(|id| lanes.lane(*id))
+                .min_by(|a, b| {
+                    let off = |l: &Lane| l.project(p_m).d_m.abs();
+                    off(a).total_cmp(&off(b))
+                });
+            match next {
+                Some(next) => self.lane = next.id(),
+                None => return,
+            }
+        }
+    }
+
     /// MOBIL's choice at this tick: the neighbouring lane to change to, if any (module doc).
     /// `own` is the held lane and `own_users` everybody in its frame ([`in_frame`]).
     fn mobil_target(
@@ -176,6 +206,15 @@ impl IdmDriver {
             };
             let users = in_frame(target, obs);
             let s_target = users[0].x_m;
+            // A lane that does not exist beside the car yet (or any more) is no target; nor is
+            // one that ends closed ahead when the held lane does not (the lane rule of the
+            // planners: an acceleration lane is not a lane to overtake in).
+            let ends_ahead = lanes
+                .distance_to_closed_end_m(target_id, s_target)
+                .is_some();
+            if !(0.0..=target.length_m()).contains(&s_target) || (ends_ahead && !own_ends) {
+                continue;
+            }
             let (leader_after, follower_after) =
                 around(&self.params, lanes, target_id, &users, s_target, fit);
             // The target lane's drivers in its own frame, me at my arc length there.
@@ -194,10 +233,7 @@ impl IdmDriver {
                 }),
                 leader_after,
                 follower_after,
-                leaving_ending_lane: own_ends
-                    && lanes
-                        .distance_to_closed_end_m(target_id, s_target)
-                        .is_none(),
+                leaving_ending_lane: own_ends && !ends_ahead,
             };
             let verdict = decide(&self.params, mobil, &n);
             if verdict.change && best.is_none_or(|(_, b)| verdict.incentive_mps2 > b.incentive_mps2)
@@ -214,6 +250,9 @@ impl Behaviour for IdmDriver {
     /// or the lane's closed end), turned into the speed profile of a lane-keeping path; with
     /// MOBIL, after a lane change if one is due.
     fn plan(&mut self, obs: &Observation<'_>) -> Result<Decision, BehaviourError> {
+        if self.mobil.is_some() {
+            self.follow_into_successor(obs.lanes, [obs.ego.x_m, obs.ego.y_m]);
+        }
         // Everybody in the held lane's frame: s along it, d across it.
         let Some(mut lane) = obs.lanes.lane(self.lane) else {
             return Err(format!("lane {} is not on the road", self.lane).into());
