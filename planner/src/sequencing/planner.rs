@@ -27,7 +27,6 @@ use std::sync::Arc;
 use mergesim_types::lanes::LaneRoad;
 use mergesim_types::{
     Behaviour, BehaviourError, Decision, GridSpec, Observation, OptimiserReport, PathPoint,
-    SharedLocalPath,
 };
 
 use super::geometry::{MergeGeometry, MergeSide};
@@ -327,20 +326,12 @@ impl Behaviour for SequencedPlanner {
         }
         match self.sequence(obs, &decision.path) {
             None => Ok(decision),
-            Some(path) => {
-                let broadcast = SharedLocalPath::from_path(
-                    obs.ego_id,
-                    obs.time_s,
-                    obs.ego_shape,
-                    obs.ego.speed_mps,
-                    &path,
-                );
-                Ok(Decision {
-                    path,
-                    broadcast: Some(broadcast),
-                    ..decision
-                })
-            }
+            // The sequenced path, shared as PF-ISO shares its own (the fallback is `None`
+            // here: checked above).
+            Some(path) => Ok(Decision {
+                degraded_mode: decision.degraded_mode,
+                ..Decision::follow_and_share(path, obs)
+            }),
         }
     }
 
