@@ -223,4 +223,14 @@ fn on_the_on_ramp_an_idm_mobil_driver_leaves_the_acceleration_lane_and_no_main_r
         traffic["merged_before_lane_end"], traffic["merging"],
         "{traffic}"
     );
+    // `idm-mobil` as a planner name (a study's baseline): the same drivers on the same
+    // instance, so the same run: the same events and traffic figures, classes included.
+    let by_name = common::run_summary(
+        &dir.join("by_name.json"),
+        &["--scenario", "on_ramp_flow", "--planner", "idm-mobil"],
+    );
+    assert_eq!(by_name["events"], summary["events"]);
+    assert_eq!(by_name["traffic"], summary["traffic"]);
+    assert_eq!(by_name["min_gap_m"], summary["min_gap_m"]);
+    assert_eq!(by_name["traffic"]["classes"][0]["class"], "idm-mobil");
 }

@@ -289,7 +289,7 @@ def test_unknown_planner_lists_the_python_ones() -> None:
     with pytest.raises(mergesim.ScenarioError) as raised:
         mergesim.run("urgent_merge", planner="nope")
     assert str(raised.value) == (
-        "unknown planner 'nope'; valid: pf-cs, pf-iso, pf-iso-pred, pf-iso-seq, pf-sp, "
+        "unknown planner 'nope'; valid: idm-mobil, pf-cs, pf-iso, pf-iso-pred, pf-iso-seq, pf-sp, "
         f"pf-sp-eq10, py-boom-test, {CRUISE}"
     )
 

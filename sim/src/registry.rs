@@ -84,6 +84,7 @@ use planner::sequencing::{SEQUENCED_PLANNER_NAME, SequencedPlanner, SequencingPa
 use planner::{PfPlanner, PlannerKind};
 
 use crate::config::{SimConfig, VehicleSpec};
+use crate::drivers::IdmDriver;
 use crate::error::SimError;
 use crate::planner_params::{
     ParamsError, ParamsTable, ParsedParams, PlannerParameters, overlay, parse_typed,
@@ -165,6 +166,26 @@ impl std::fmt::Debug for BehaviourRegistry {
     }
 }
 
+/// The name under which the human driver model IDM + MOBIL (`driver = "idm-mobil"`) is also
+/// registered as a planner, so that a study, a sweep or `--planner` can put it in place of the
+/// planner-driven vehicles' planner: the baseline of a comparison, on the same instances. It
+/// takes no planner parameters (its own are `[sim.idm]` and `[sim.mobil]`), shares no path over
+/// V2V and is never shielded (`Behaviour::is_planner` is false).
+pub const HUMAN_DRIVER_PLANNER_NAME: &str = "idm-mobil";
+
+/// The factory of the IDM + MOBIL driver (`HUMAN_DRIVER_PLANNER_NAME`): the vehicle's start lane
+/// and offset, the scenario's IDM and MOBIL parameters, exactly as `driver = "idm-mobil"`.
+fn human_driver_factory() -> BehaviourFactory {
+    Arc::new(|input: &FactoryInput<'_>| {
+        Ok(Box::new(IdmDriver::new(
+            input.config.idm.clone(),
+            input.spec.lane.id(),
+            input.spec.y_offset_m,
+            Some(input.config.mobil.clone()),
+        )) as Box<dyn Behaviour>)
+    })
+}
+
 /// The factory of a potential-field planner of `kind`.
 fn pf_factory(kind: PlannerKind) -> BehaviourFactory {
     Arc::new(move |input: &FactoryInput<'_>| {
@@ -212,8 +233,9 @@ impl BehaviourRegistry {
         self.vehicle_models.register(name, description, factory)
     }
 
-    /// The paper's planners under their names (`PlannerKind::name`), and merge sequencing
-    /// (`pf-iso-seq`, with its own parameter type).
+    /// The paper's planners under their names (`PlannerKind::name`), merge sequencing
+    /// (`pf-iso-seq`, with its own parameter type) and the IDM + MOBIL human driver
+    /// (`idm-mobil`, [`HUMAN_DRIVER_PLANNER_NAME`]).
     pub fn builtin() -> Self {
         let mut registry = Self::new();
         for kind in PlannerKind::ALL {
@@ -251,6 +273,13 @@ impl BehaviourRegistry {
             SEQUENCED_PLANNER_NAME.to_string(),
             Schema::Typed(Arc::new(parse_typed::<SequencingParams>)),
         );
+        registry.factories.insert(
+            HUMAN_DRIVER_PLANNER_NAME.to_string(),
+            human_driver_factory(),
+        );
+        registry
+            .schemas
+            .insert(HUMAN_DRIVER_PLANNER_NAME.to_string(), Schema::None);
         registry
     }
 
@@ -469,6 +498,7 @@ mod tests {
         let mut registry = BehaviourRegistry::builtin();
         let mut expected: Vec<&str> = PlannerKind::ALL.iter().map(|k| k.name()).collect();
         expected.push(SEQUENCED_PLANNER_NAME);
+        expected.push(HUMAN_DRIVER_PLANNER_NAME);
         expected.sort_unstable();
         assert_eq!(registry.names(), expected);
         let factory = pf_factory(PlannerKind::PfCs);
