@@ -53,7 +53,7 @@ fn the_opendrive_scenario_runs_from_another_directory() {
 
 #[test]
 fn a_missing_or_broken_road_file_exits_2_naming_toml_line_and_field() {
-    let dir = scratch("bad");
+    let dir = scratch("opendrive_bad");
     let text = std::fs::read_to_string(scenario()).expect("scenario");
     let broken = dir.join("broken.xodr");
     std::fs::write(&broken, "<OpenDRIVE><road").expect("write");

@@ -132,7 +132,7 @@ fn a_scenario_mixes_models_per_vehicle_and_the_cli_overrides_them() {
         ],
     );
     assert_eq!(all_st["vehicle_model"], "st");
-    let st = run_json("model_st", &["--vehicle-model", "st"]);
+    let st = run_json("model_mixed_st_only", &["--vehicle-model", "st"]);
     // Everything but the scenario's name and the wall-clock figures.
     let strip = |mut v: serde_json::Value| {
         let o = v.as_object_mut().unwrap();
