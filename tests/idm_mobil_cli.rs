@@ -163,6 +163,33 @@ fn the_mobil_table_is_read_and_checked() {
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("idm-mobil"), "{err}");
+
+    // As a planner name it takes no planner parameters, and says where the driver's are.
+    let params = dir.join("planner_params.toml");
+    std::fs::write(
+        &params,
+        urgent_merge_with(
+            "{ planner = \"pf-iso\" }",
+            "[sim.planners.idm-mobil]\npoliteness = 0.5\n",
+        ),
+    )
+    .unwrap();
+    let json = dir.join("params.json");
+    let out = merge_sim(&[
+        "run",
+        "--scenario",
+        params.to_str().unwrap(),
+        "--planner",
+        "idm-mobil",
+        "--no-rrd",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("planners.idm-mobil.politeness"), "{err}");
+    assert!(err.contains("[sim.mobil]"), "{err}");
+    assert!(!json.exists());
 }
 
 /// The built-in scenario `name` as `merge_sim scenario show` prints it, with every

@@ -93,18 +93,8 @@ pub fn behaviour_of(
             lane: spec.lane.id(),
             d_offset_m: spec.y_offset_m,
         }),
-        Driver::Idm => Box::new(IdmDriver::new(
-            config.idm.clone(),
-            spec.lane.id(),
-            spec.y_offset_m,
-            None,
-        )),
-        Driver::IdmMobil => Box::new(IdmDriver::new(
-            config.idm.clone(),
-            spec.lane.id(),
-            spec.y_offset_m,
-            Some(config.mobil.clone()),
-        )),
+        Driver::Idm => Box::new(IdmDriver::for_vehicle(config, spec, false)),
+        Driver::IdmMobil => Box::new(IdmDriver::for_vehicle(config, spec, true)),
     })
 }
 

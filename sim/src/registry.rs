@@ -177,12 +177,7 @@ pub const HUMAN_DRIVER_PLANNER_NAME: &str = "idm-mobil";
 /// and offset, the scenario's IDM and MOBIL parameters, exactly as `driver = "idm-mobil"`.
 fn human_driver_factory() -> BehaviourFactory {
     Arc::new(|input: &FactoryInput<'_>| {
-        Ok(Box::new(IdmDriver::new(
-            input.config.idm.clone(),
-            input.spec.lane.id(),
-            input.spec.y_offset_m,
-            Some(input.config.mobil.clone()),
-        )) as Box<dyn Behaviour>)
+        Ok(Box::new(IdmDriver::for_vehicle(input.config, input.spec, true)) as Box<dyn Behaviour>)
     })
 }
 
@@ -372,6 +367,13 @@ impl BehaviourRegistry {
                 let written = overlay(scenario, vehicle);
                 match written.keys().next() {
                     None => Ok(None),
+                    Some(key) if name == HUMAN_DRIVER_PLANNER_NAME => Err(ParamsError::at(
+                        key.clone(),
+                        format!(
+                            "planner {name} takes no planner parameters: the human driver's \
+                             are [sim.idm] and [sim.mobil]"
+                        ),
+                    )),
                     Some(key) => Err(ParamsError::at(
                         key.clone(),
                         format!(

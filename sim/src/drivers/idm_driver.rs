@@ -16,6 +16,7 @@
 use mergesim_types::lanes::{Lane, LaneId, LaneRoad, Side};
 use mergesim_types::{Behaviour, BehaviourError, Decision, Observation};
 
+use crate::config::{SimConfig, VehicleSpec};
 use crate::drivers::lane_path;
 use crate::idm::{IdmParams, RoadUser, find_leader, idm_acceleration, speed_after_distance};
 use crate::mobil::{LaneDriver, MobilParams, Neighbourhood, Verdict, decide};
@@ -50,6 +51,19 @@ impl IdmDriver {
             mobil,
             last_change_t_s: None,
         }
+    }
+
+    /// The driver of vehicle `spec`: the scenario's IDM parameters (`[sim.idm]`), holding the
+    /// vehicle's start lane at its offset, with MOBIL lane changes (`[sim.mobil]`) if
+    /// `lane_changes` (`driver = "idm-mobil"`, or the planner name `idm-mobil`), else none
+    /// (`driver = "idm"`).
+    pub fn for_vehicle(config: &SimConfig, spec: &VehicleSpec, lane_changes: bool) -> Self {
+        Self::new(
+            config.idm.clone(),
+            spec.lane.id(),
+            spec.y_offset_m,
+            lane_changes.then(|| config.mobil.clone()),
+        )
     }
 }
 
