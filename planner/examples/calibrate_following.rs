@@ -3,12 +3,17 @@
 //! lane, a follower (target 20 m/s) settles at the D_min of its own field, within ±10 %.
 //!
 //! `cargo run --release -p planner --example calibrate_following`
+//!
+//! `-- --arms`: the same criterion in each arm of the `paper` set's attribution (docs/studies/
+//! paper_attribution/): U_SLP reading × D_min roles × σ_y form, w_R from PF-SP and w3 from
+//! PF-ISO-PRED (as `tests/calibration.rs`), each twice its smallest weight, rounded.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use planner::PlannerKind;
-use planner::params::PlannerParams;
+use planner::obstacle_field::LateralForm;
+use planner::params::{PlannerParams, SlpReading};
+use planner::{ParameterSet, PlannerKind};
 
 fn scan_floor() {
     let base = PlannerParams::default();
@@ -81,7 +86,52 @@ fn thresholds() {
     }
 }
 
+/// The smallest following weight of `kind` in the arm, searched over [0.1, 1000]; twice it,
+/// rounded, or None when no weight in that range keeps the follower behind.
+fn arm_weight(kind: PlannerKind, params: &PlannerParams) -> (Option<f64>, Option<f64>) {
+    let smallest = common::try_smallest_following_weight(kind, params, 0.1, 1000.0);
+    (smallest, smallest.map(|w| (2.0 * w).round()))
+}
+
+fn arms() {
+    println!(
+        "| U_SLP reading | D_min roles | σ_y | w_R: smallest (PF-SP) | w_R = 2×, rounded | w3: smallest (PF-ISO-PRED) | w3 = 2×, rounded |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    let show = |w: Option<f64>, digits: usize| {
+        w.map_or("none in [0.1, 1000]".to_string(), |w| {
+            format!("{w:.digits$}")
+        })
+    };
+    for reading in [SlpReading::FixedWaypoints, SlpReading::ArcLength] {
+        for by_side in [false, true] {
+            for lateral in [LateralForm::FixedDistance, LateralForm::PrintedLaplace] {
+                let params = PlannerParams {
+                    interaction_slp_reading: reading,
+                    obstacle_min_distance_by_side: by_side,
+                    obstacle_lateral_form: lateral,
+                    ..ParameterSet::Paper.planner_params()
+                };
+                let (r_small, r_w) = arm_weight(PlannerKind::PfSp, &params);
+                let (i_small, i_w) = arm_weight(PlannerKind::PfIsoPred, &params);
+                println!(
+                    "| {reading:?} | {} | {lateral:?} | {} | {} | {} | {} |",
+                    if by_side { "by side" } else { "printed" },
+                    show(r_small, 2),
+                    show(r_w, 0),
+                    show(i_small, 2),
+                    show(i_w, 0),
+                );
+            }
+        }
+    }
+}
+
 fn main() {
+    if std::env::args().any(|a| a == "--arms") {
+        arms();
+        return;
+    }
     if std::env::args().any(|a| a == "--thresholds") {
         thresholds();
         return;

@@ -20,6 +20,21 @@ pub enum HeadingForm {
     Rotation,
 }
 
+/// How Eq. 4's lateral term decays (module doc of `obstacle_field`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LateralForm {
+    /// σ_y = d_lat / √(−2 ln(ε/A)) under the square: a Gaussian that is ε at the lateral
+    /// safety distance d_lat (both parameter sets).
+    FixedDistance,
+    /// σ_y as printed, √(−(Y − Y_o)² / (2 ln(ε/A))) = |Y − Y_o| / k with k = √(−2 ln(ε/A)),
+    /// entering Eq. 4 unsquared: the lateral term (Y − Y_o)²/σ_y = k·|Y − Y_o| (a Laplace
+    /// profile whose length scale is a unit slip, 1 m) and, in the correlation form,
+    /// C2 = 2ψ_o k (X − X_o) sgn(Y − Y_o) / σ_x. An option for attributing the `paper` set's
+    /// results; neither set uses it by default.
+    PrintedLaplace,
+}
+
 /// Which length enters D_min's constant term (l_fr + l_fr,o)/2 (module doc).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -65,12 +80,19 @@ pub struct ObstacleFieldParams {
     pub min_distance_length: MinDistanceLength,
     /// Roles by side (true) or the planning vehicle always the follower (false, as printed).
     pub min_distance_by_side: bool,
+    /// The lateral term's form.
+    pub lateral_form: LateralForm,
 }
 
 impl ObstacleFieldParams {
     /// √(−2 ln f): σ_x = D_min / this.
     pub(crate) fn x_scale(&self) -> f64 {
         (-2.0 * self.fraction_at_min_distance.ln()).sqrt()
+    }
+
+    /// k = √(−2 ln(ε/A)) (1/m: the printed σ_y is |Y − Y_o|/k, [`LateralForm::PrintedLaplace`]).
+    pub(crate) fn lateral_laplace_rate_per_m(&self) -> f64 {
+        (-2.0 * (self.epsilon / self.amplitude).ln()).sqrt()
     }
 
     /// σ_y (m).

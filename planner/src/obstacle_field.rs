@@ -25,7 +25,11 @@
 //!   The printed σ_y contains Y − Y_o itself: with σ_y² under the square the lateral term is the
 //!   constant 2 ln(A/ε) (no lateral decay at all); with σ_y as printed (not squared) it is
 //!   |Y − Y_o|·√(2 ln(A/ε)), an exponential profile whose length scale is a unit slip (1 m).
-//!   Neither gives a field that decays over a chosen distance, so both sets fix d_lat.
+//!   Neither gives a field that decays over a chosen distance, so both sets fix d_lat
+//!   ([`LateralForm::FixedDistance`]). The unsquared printed form is an option
+//!   (`obstacle_lateral_form = "printed-laplace"`, [`LateralForm::PrintedLaplace`]) for
+//!   measuring what that reading does: q's lateral half is k·|u_y|/2 with k = √(−2 ln(ε/A)),
+//!   and in the correlation form C2 = 2ψ_o k dx sgn(dy)/σ_x.
 //! - σ_x = D_min / √(−2 ln f): the field is the fraction f of A_obs at D_min (the printed
 //!   σ_x = D_min √(−1/ln U) has U undefined and lacks the factor 2).
 //! - D_min is clamped to at least its length term (a negative D_min would flip the field).
@@ -39,7 +43,8 @@
 use mergesim_types::VehicleShape;
 
 pub use crate::field_params::{
-    HeadingForm, MAX_CORRELATION_HEADING_RAD, MinDistanceLength, ObstacleFieldParams, Role,
+    HeadingForm, LateralForm, MAX_CORRELATION_HEADING_RAD, MinDistanceLength, ObstacleFieldParams,
+    Role,
 };
 pub use crate::min_distance::{MinDistances, SelfView, min_distance_m, min_distances};
 
@@ -65,8 +70,12 @@ pub struct ObstacleField {
     pub sigma_front_m: f64,
     /// σ_x behind the obstacle (m).
     pub sigma_rear_m: f64,
-    /// σ_y (m).
+    /// σ_y (m) of [`LateralForm::FixedDistance`].
     pub sigma_lateral_m: f64,
+    /// The lateral term's form.
+    pub lateral_form: LateralForm,
+    /// k = √(−2 ln(ε/A)) (1/m) of [`LateralForm::PrintedLaplace`].
+    pub lateral_laplace_rate_per_m: f64,
     /// A_obs.
     pub amplitude: f64,
     /// Heading terms.
@@ -107,6 +116,8 @@ impl ObstacleField {
             sigma_front_m: d.front_m / x_scale,
             sigma_rear_m: d.rear_m / x_scale,
             sigma_lateral_m: params.sigma_lateral_m(),
+            lateral_form: params.lateral_form,
+            lateral_laplace_rate_per_m: params.lateral_laplace_rate_per_m(),
             amplitude: params.amplitude,
             heading_form: params.heading_form,
         }
@@ -202,10 +213,17 @@ impl ObstacleField {
             HeadingForm::Rotation => {
                 let ux = self.cos_heading * dx + self.sin_heading * dy;
                 let uy = -self.sin_heading * dx + self.cos_heading * dy;
-                let q = 0.5 * (ux * ux / (sx * sx) + uy * uy / (sy * sy));
-                // dq/du = (u_x/σ_x², u_y/σ_y²); du/dp = R(ψ)ᵀ.
+                // The lateral half: u_y²/σ_y², or k·|u_y| as printed (LateralForm).
+                let (lateral, qy) = match self.lateral_form {
+                    LateralForm::FixedDistance => (uy * uy / (sy * sy), uy / (sy * sy)),
+                    LateralForm::PrintedLaplace => {
+                        let k = self.lateral_laplace_rate_per_m;
+                        (k * uy.abs(), 0.5 * k * sign(uy))
+                    }
+                };
+                let q = 0.5 * (ux * ux / (sx * sx) + lateral);
+                // dq/du = (u_x/σ_x², ∂/∂u_y); du/dp = R(ψ)ᵀ.
                 let qx = ux / (sx * sx);
-                let qy = uy / (sy * sy);
                 let grad = [
                     qx * self.cos_heading - qy * self.sin_heading,
                     qx * self.sin_heading + qy * self.cos_heading,
@@ -219,18 +237,37 @@ impl ObstacleField {
                 let (dx, dy) = (lc * dx + ls * dy, -ls * dx + lc * dy);
                 let psi = self.heading_rad;
                 let c1 = 1.0 - psi * psi;
-                let (a, b, c) = (1.0 / (sx * sx), 1.0 / (sy * sy), psi / (sx * sy));
-                let q = 0.5 * c1 * (a * dx * dx + b * dy * dy - 2.0 * c * dx * dy);
-                let g = [c1 * (a * dx - c * dy), c1 * (b * dy - c * dx)];
-                let grad = [lc * g[0] - ls * g[1], ls * g[0] + lc * g[1]];
-                // ∂a/∂σ_x = −2/σ_x³, ∂c/∂σ_x = −c/σ_x.
-                let d_sigma = 0.5 * c1 * (-2.0 * dx * dx / (sx * sx * sx) + 2.0 * c * dx * dy / sx);
-                (q, grad, d_sigma)
+                match self.lateral_form {
+                    LateralForm::FixedDistance => {
+                        let (a, b, c) = (1.0 / (sx * sx), 1.0 / (sy * sy), psi / (sx * sy));
+                        let q = 0.5 * c1 * (a * dx * dx + b * dy * dy - 2.0 * c * dx * dy);
+                        let g = [c1 * (a * dx - c * dy), c1 * (b * dy - c * dx)];
+                        let grad = [lc * g[0] - ls * g[1], ls * g[0] + lc * g[1]];
+                        // ∂a/∂σ_x = −2/σ_x³, ∂c/∂σ_x = −c/σ_x.
+                        let d_sigma =
+                            0.5 * c1 * (-2.0 * dx * dx / (sx * sx * sx) + 2.0 * c * dx * dy / sx);
+                        (q, grad, d_sigma)
+                    }
+                    LateralForm::PrintedLaplace => {
+                        // σ_y = |dy|/k unsquared: dy²/σ_y = k|dy|, and
+                        // 2ψ dx dy/(σ_x σ_y) = 2ψ k dx sgn(dy)/σ_x.
+                        let k = self.lateral_laplace_rate_per_m;
+                        let a = 1.0 / (sx * sx);
+                        let cross = psi * k * sign(dy) / sx;
+                        let q = 0.5 * c1 * (a * dx * dx + k * dy.abs() - 2.0 * cross * dx);
+                        let g = [c1 * (a * dx - cross), 0.5 * c1 * k * sign(dy)];
+                        let grad = [lc * g[0] - ls * g[1], ls * g[0] + lc * g[1]];
+                        let d_sigma =
+                            0.5 * c1 * (-2.0 * dx * dx / (sx * sx * sx) + 2.0 * cross * dx / sx);
+                        (q, grad, d_sigma)
+                    }
+                }
             }
         }
     }
 
-    /// The exponent q with U = A·exp(−q) (q ≥ 0).
+    /// The exponent q with U = A·exp(−q) (q ≥ 0, except in the printed Laplace form with the
+    /// correlation form, where C2 can make it negative near the centre: U > A there).
     pub(crate) fn exponent(&self, x_m: f64, y_m: f64) -> f64 {
         self.exponent_and_derivatives(x_m, y_m).0
     }
@@ -261,6 +298,18 @@ impl ObstacleField {
     }
 }
 
+/// The sign of `v`, 0 at 0 (the derivative of |v| where it has one, and the middle of its
+/// subgradient at 0).
+fn sign(v: f64) -> f64 {
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
 fn cap_heading(heading_rad: f64) -> f64 {
     mergesim_types::angle::wrap_angle_rad(heading_rad)
         .clamp(-MAX_CORRELATION_HEADING_RAD, MAX_CORRELATION_HEADING_RAD)
@@ -278,7 +327,8 @@ mod tests {
         }
     }
 
-    fn forms() -> [ObstacleFieldParams; 2] {
+    /// Both heading forms, each with both lateral forms.
+    fn forms() -> [ObstacleFieldParams; 4] {
         let rotation = PlannerParams::default().path_field();
         let paper = ObstacleFieldParams {
             heading_form: HeadingForm::PaperCorrelation,
@@ -287,7 +337,11 @@ mod tests {
             time_gap_s: 0.0,
             ..rotation
         };
-        [rotation, paper]
+        let laplace = |p: ObstacleFieldParams| ObstacleFieldParams {
+            lateral_form: LateralForm::PrintedLaplace,
+            ..p
+        };
+        [rotation, paper, laplace(rotation), laplace(paper)]
     }
 
     #[test]
@@ -310,6 +364,10 @@ mod tests {
                 (10.0, 5.0),
                 (45.0, 9.0),
             ] {
+                // The printed C2 flips sign with Y − Y_o: no derivative across Y = Y_o.
+                if params.lateral_form == LateralForm::PrintedLaplace && y == 5.0 {
+                    continue;
+                }
                 let g = field.gradient(x, y);
                 let fx = (field.value(x + h, y) - field.value(x - h, y)) / (2.0 * h);
                 let fy = (field.value(x, y + h) - field.value(x, y - h)) / (2.0 * h);
@@ -345,6 +403,40 @@ mod tests {
                 let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
                 assert!((du - fd).abs() < 1e-7, "({x},{y}): {du} vs {fd}");
             }
+        }
+    }
+
+    #[test]
+    fn printed_laplace_lateral_term_is_k_times_the_offset() {
+        let params = ObstacleFieldParams {
+            lateral_form: LateralForm::PrintedLaplace,
+            ..PlannerParams::default().path_field()
+        };
+        let k = (-2.0 * (params.epsilon / params.amplitude).ln()).sqrt();
+        for heading_form in [HeadingForm::Rotation, HeadingForm::PaperCorrelation] {
+            let params = ObstacleFieldParams {
+                heading_form,
+                ..params
+            };
+            let shape = VehicleShape::default();
+            let field = ObstacleField::new(&params, me(20.0), 0.0, 0.0, 0.0, 15.0, &shape);
+            for y in [-3.5, 0.5, 1.0, 3.5] {
+                let expected = params.amplitude * (-0.5 * k * f64::abs(y)).exp();
+                assert!(
+                    (field.value(0.0, y) - expected).abs() < 1e-15,
+                    "{heading_form:?} {y}"
+                );
+            }
+            // Not the fixed-distance Gaussian: at d_lat it is not ε.
+            let at_d = field.value(0.0, params.lateral_safety_m);
+            assert!((at_d - params.epsilon).abs() > 1e-4, "{at_d}");
+        }
+        // Neither parameter set uses it.
+        for set in [crate::ParameterSet::Paper, crate::ParameterSet::Mergesim] {
+            assert_eq!(
+                set.planner_params().obstacle_lateral_form,
+                LateralForm::FixedDistance
+            );
         }
     }
 

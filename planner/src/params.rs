@@ -11,7 +11,7 @@ use mergesim_types::bounds::{self, Bound};
 
 use crate::error::PlannerError;
 use crate::following::V2vLossFallback;
-use crate::obstacle_field::{HeadingForm, MinDistanceLength, ObstacleFieldParams};
+use crate::obstacle_field::{HeadingForm, LateralForm, MinDistanceLength, ObstacleFieldParams};
 use crate::prediction::PredictionModel;
 use crate::speed_optimisation::SpeedProgram;
 
@@ -89,6 +89,10 @@ pub struct PlannerParams {
     /// D_min with roles by side (ahead of the obstacle it is the follower) instead of the
     /// planning vehicle always being the follower, as printed. Shared.
     pub obstacle_min_distance_by_side: bool,
+    /// Eq. 4's lateral term: `fixed-distance` (σ_y = d_lat/√(−2 ln(ε/A)), a Gaussian that is ε
+    /// at d_lat; both sets) or `printed-laplace` (σ_y as printed, |Y − Y_o|/√(−2 ln(ε/A)),
+    /// unsquared: a Laplace profile). Shared by the path field and the interaction term.
+    pub obstacle_lateral_form: LateralForm,
 
     // ---------------------------------------------------------------- Eq. 7 (waypoints)
     /// N, number of waypoints (≥ 4).
@@ -292,6 +296,7 @@ impl Default for PlannerParams {
             ego_mass_factor: 1.0,
             other_mass_factor: 1.0,
             obstacle_heading_form: HeadingForm::Rotation,
+            obstacle_lateral_form: LateralForm::FixedDistance,
             obstacle_min_distance_length: MinDistanceLength::BodyLength,
             obstacle_min_distance_by_side: true,
             waypoint_count: 20,
@@ -573,6 +578,7 @@ impl PlannerParams {
             heading_form: self.obstacle_heading_form,
             min_distance_length: self.obstacle_min_distance_length,
             min_distance_by_side: self.obstacle_min_distance_by_side,
+            lateral_form: self.obstacle_lateral_form,
         }
     }
 

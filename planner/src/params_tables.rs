@@ -63,6 +63,7 @@ pub const ALL_FIELDS: &[&str] = &[
     "obstacle_heading_form",
     "obstacle_min_distance_length",
     "obstacle_min_distance_by_side",
+    "obstacle_lateral_form",
     "waypoint_count",
     "step_time_s",
     "min_step_m",

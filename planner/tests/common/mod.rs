@@ -103,16 +103,26 @@ pub fn keeps_behind(kind: PlannerKind, params: &PlannerParams) -> bool {
 /// The smallest weight (w_R for PF-SP, w3 otherwise) with which the follower keeps behind,
 /// by bisection over [lo, hi] to a relative precision of 1 %.
 pub fn smallest_following_weight(kind: PlannerKind, base: &PlannerParams, lo: f64, hi: f64) -> f64 {
+    try_smallest_following_weight(kind, base, lo, hi).expect("bracket")
+}
+
+/// [`smallest_following_weight`], or None when [lo, hi] does not bracket it (the follower
+/// keeps behind already at `lo`, or not even at `hi`).
+pub fn try_smallest_following_weight(
+    kind: PlannerKind,
+    base: &PlannerParams,
+    lo: f64,
+    hi: f64,
+) -> Option<f64> {
     let with = |w: f64| PlannerParams {
         risk_weight: w,
         interaction_weight: w,
         ..base.clone()
     };
     let (mut lo, mut hi) = (lo, hi);
-    assert!(
-        !keeps_behind(kind, &with(lo)) && keeps_behind(kind, &with(hi)),
-        "bracket"
-    );
+    if keeps_behind(kind, &with(lo)) || !keeps_behind(kind, &with(hi)) {
+        return None;
+    }
     while hi / lo > 1.01 {
         let mid = (lo * hi).sqrt();
         if keeps_behind(kind, &with(mid)) {
@@ -121,7 +131,7 @@ pub fn smallest_following_weight(kind: PlannerKind, base: &PlannerParams, lo: f6
             lo = mid;
         }
     }
-    hi
+    Some(hi)
 }
 
 /// D_min of a follower behind a leader at the same speed `v` (the braking terms cancel):
