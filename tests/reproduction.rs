@@ -308,31 +308,28 @@ fn paper_set_pf_cs_obstacle_winds_in_the_merge_zone() {
     assert_eq!(collisions(&cs), 0);
 }
 
-/// The `paper` set: PF-SP brakes late; PF-ISO starts slowing earlier. In this reading the
-/// vehicle PF-ISO slows first is the ego: with the printed D_min the planning vehicle is always
-/// the follower, so the interaction term slows the faster vehicle first (docs/reproduction.md).
-/// Measured 2026-12-02, path points carrying the speed of their own instant: PF-SP's obstacle
-/// brakes at 10.45 s (to 14.50 m/s); PF-ISO's ego slows at 8.80 s, its obstacle at 10.65 s (to
-/// 14.62 m/s). Before that fix PF-ISO's obstacle did not slow and PF-SP's dipped 0.11 m/s at
-/// 13.85 s (CHANGELOG). This pairs PF-ISO's first slowing vehicle with PF-SP's obstacle, as the
-/// paper's text does; the preregistered comparison re-examines it.
+/// The `paper` set, car for car: PF-ISO slows its *ego* first, and its obstacle does not slow
+/// before PF-SP's. With the printed D_min the planning vehicle is always the follower, so the
+/// interaction term slows the faster vehicle (docs/reproduction.md). Measured 2026-12-02 on
+/// the nominal run: PF-SP's obstacle brakes at 10.45 s (to 14.50 m/s); PF-ISO's ego slows at
+/// 8.80 s, its obstacle at 10.65 s. Over 100 paired instances (docs/studies/paper_sensitivity,
+/// 8 s horizon) PF-ISO's obstacle slows +0.13 s [−0.08, +0.34] after PF-SP's where both slow.
+/// An earlier version of this test set PF-ISO's first slowing car (the ego) against PF-SP's
+/// obstacle, which compared different cars.
 #[test]
-fn paper_set_pf_sp_brakes_later_than_pf_iso() {
+fn paper_set_pf_iso_slows_the_ego_and_not_the_obstacle_before_pf_sp() {
     let scenario = variant(ParameterSet::Paper, Perturbation::Nominal);
     let [sp, iso] = run_kinds(&scenario, [PlannerKind::PfSp, PlannerKind::PfIso]);
-    let sp_onset = paper(&sp, OBSTACLE).slowing_onset_s.expect("PF-SP brakes");
-    let first = |o: &RunOutcome| {
-        [EGO, OBSTACLE]
-            .iter()
-            .filter_map(|v| paper(o, v).slowing_onset_s)
-            .fold(f64::INFINITY, f64::min)
-    };
-    assert!(first(&iso) < sp_onset, "{} vs {sp_onset}", first(&iso));
+    let sp_obstacle = paper(&sp, OBSTACLE).slowing_onset_s.expect("PF-SP brakes");
     let iso_ego = paper(&iso, EGO)
         .slowing_onset_s
         .expect("PF-ISO slows the ego");
     if let Some(iso_obstacle) = paper(&iso, OBSTACLE).slowing_onset_s {
         assert!(iso_ego < iso_obstacle, "{iso_ego} vs {iso_obstacle}");
+        assert!(
+            iso_obstacle >= sp_obstacle,
+            "PF-ISO's obstacle at {iso_obstacle} s, PF-SP's at {sp_obstacle} s"
+        );
     }
     for outcome in [&sp, &iso] {
         assert_eq!(collisions(outcome), 0);

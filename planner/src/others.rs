@@ -247,7 +247,7 @@ pub(crate) fn arc_length_term(
 
 /// The paper's reading of U_SLP (module doc of `speed_optimisation::fixed_waypoint_term`): the
 /// ego's Eq. 7 waypoint i against each other's pose and speed at slot i, with the interaction
-/// term's fields (`field_params`) and floor ε_I (`floor`).
+/// term's fields (`field_params`) and floor U₀ (`floor`).
 #[allow(clippy::too_many_arguments)] // the term's inputs, each used once
 pub(crate) fn fixed_waypoint_term(
     horizon: &PlanHorizon,

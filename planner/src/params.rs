@@ -325,7 +325,7 @@ impl Default for PlannerParams {
             // slower leader on a single lane (6.0; a stability margin of 2, the same criterion
             // as `risk_weight`; docs/parameters.md, `planner/tests/calibration.rs`).
             interaction_weight: 12.0,
-            // A fifth of the field's level at D_min (0.1): ln(ε_I + U) follows the paper's ln U
+            // A fifth of the field's level at D_min (0.1): ln(U₀ + U) follows the paper's ln U
             // inside the safety ellipse and fades beyond ≈ 1.3 D_min (exp(−q) = 0.02 ⇔ q = 3.9
             // against q = 2.3 at D_min).
             interaction_floor: 0.02,

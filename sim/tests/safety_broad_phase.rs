@@ -107,6 +107,30 @@ fn the_broad_phase_gives_the_all_pairs_results_on_crowded_layouts() {
 }
 
 #[test]
+fn a_small_fleet_tested_pair_by_pair_gives_the_all_pairs_results() {
+    // Below the monitor's small-fleet size the X test runs on every pair instead of the sweep.
+    let (mut collisions, mut closing) = (0, 0);
+    for seed in 30..36 {
+        let (_, summary) = compare(SafetyParams::default(), seed, 20, 300.0, 60);
+        collisions += summary.collisions.len();
+        closing += summary
+            .pairs
+            .iter()
+            .filter(|p| p.min_ttc_s.is_some())
+            .count();
+    }
+    assert!(collisions > 0 && closing > 0, "{collisions} {closing}");
+    // A small window (10 m) leaves pairs out of the X test as well.
+    let params = SafetyParams {
+        pair_range_m: 10.0,
+        ttc_horizon_s: 1.5,
+        ..SafetyParams::default()
+    };
+    let (followed, _) = compare(params, 40, 20, 2000.0, 40);
+    assert!(followed < 20 * 19 / 2 * 40 / 2, "{followed}");
+}
+
+#[test]
 fn the_broad_phase_skips_pairs_beyond_the_followed_range() {
     // Slow traffic over 5 km: most pairs are neither within 250 m nor closing fast enough.
     let params = SafetyParams::default();

@@ -5,8 +5,8 @@
 //! chosen, so the speed v_i enters U_SLP^i only through D_min(v_i) in σ_x (Eq. 4):
 //!
 //! ```text
-//!   φ_i(v_i) = ln(ε_I + Σ_o U_OB^o(p_i; q_o(t_0 + iΔt), σ_x(D_min(v_i, v_o,i)))) − ln ε_I
-//!   ∂φ_i/∂v_i = Σ_o ∂U^o/∂σ_x · ∂D_min/∂v_i / √(−2 ln f)  /  (ε_I + Σ_o U^o)
+//!   φ_i(v_i) = ln(U₀ + Σ_o U_OB^o(p_i; q_o(t_0 + iΔt), σ_x(D_min(v_i, v_o,i)))) − ln U₀
+//!   ∂φ_i/∂v_i = Σ_o ∂U^o/∂σ_x · ∂D_min/∂v_i / √(−2 ln f)  /  (U₀ + Σ_o U^o)
 //! ```
 //!
 //! p_i is the ego's i-th Eq. 7 waypoint, q_o(t) the other's shared path at the same absolute time
@@ -14,7 +14,7 @@
 //! v_o,i its speed there. The term is separable (φ_i depends on v_i alone). With the printed
 //! D_min the planning vehicle is the follower, so D_min grows with v_i and the term can only
 //! slow it down; once v_i falls to the other's speed D_min sits on its clamp and the term stops
-//! pulling. The floor ε_I is the same departure as in the arc-length reading (without it
+//! pulling. The floor U₀ is the same departure as in the arc-length reading (without it
 //! ln U = ln A − q rewards distance without bound, and far vehicles dominate).
 
 use super::SpeedTerm;

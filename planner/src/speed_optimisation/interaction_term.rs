@@ -4,7 +4,7 @@
 //! ```text
 //!   φ_i(v) = g(Σ_o U_OB^o(e_i(v); q_o(t_0 + iΔt)))
 //!   e_i(v) = path(s_i),   s_i = Δt Σ_{j ≤ i} v_j
-//!   g(U)   = ln(ε_I + U) − ln ε_I     (Aggregate::LogFloored: U_SLP, PF-ISO)
+//!   g(U)   = ln(U₀ + U) − ln U₀     (Aggregate::LogFloored: U_SLP, PF-ISO)
 //!   g(U)   = U                        (Aggregate::Linear: PF-SP's risk)
 //! ```
 //!
@@ -16,8 +16,8 @@
 //!
 //! Why a floor: the paper's `ln U_SLP` of a single Gaussian is ln A − q, a concave quadratic
 //! whose pull grows without bound with the separation, so far vehicles would dominate the speed
-//! choice; ln(ε_I + U) is ln A − q near a vehicle and fades (to 0 after subtracting the
-//! constant ln ε_I) once the others' fields fall below ε_I (`interaction_floor`).
+//! choice; ln(U₀ + U) is ln A − q near a vehicle and fades (to 0 after subtracting the
+//! constant ln U₀) once the others' fields fall below U₀ (`interaction_floor`).
 
 use super::SpeedTerm;
 use crate::obstacle_field::ObstacleField;

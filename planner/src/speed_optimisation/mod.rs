@@ -19,7 +19,7 @@
 //!              |v_{i+1} − v_i| ≤ a_max Δt,  |v_1 − v_0| ≤ a_max Δt            (optional)
 //!              |v_{i+1} − 2 v_i + v_{i−1}| ≤ j_max Δt²                        (optional)
 //!
-//!   φ_i(v) = ln(ε_I + Σ_o U_OB^o(e_i(v); q_o(t_0 + iΔt))) − ln ε_I
+//!   φ_i(v) = ln(U₀ + Σ_o U_OB^o(e_i(v); q_o(t_0 + iΔt))) − ln U₀
 //!   e_i(v) = path(s_i),   s_i = Δt Σ_{j ≤ i} v_j
 //! ```
 //!
@@ -31,9 +31,9 @@
 //! Readings (also in `planner/README.md`): the paper's `ln U_SLP` of a single Gaussian is
 //! ln A − q, a concave quadratic whose pull grows without bound with the separation, so far
 //! vehicles would dominate the speed choice; we read U_SLP as the accumulated field
-//! ε_I + Σ_o U_OB^o with a floor ε_I (`interaction_floor`): ln U ≈ ln A − q near a vehicle,
-//! and the term fades (to 0 after subtracting the constant ln ε_I) once the others' fields
-//! fall below ε_I. v_min > 0 keeps Δs/v finite (the paper writes 0 ≤ v_i).
+//! U₀ + Σ_o U_OB^o with a floor U₀ (`interaction_floor`): ln U ≈ ln A − q near a vehicle,
+//! and the term fades (to 0 after subtracting the constant ln U₀) once the others' fields
+//! fall below U₀. v_min > 0 keeps Δs/v finite (the paper writes 0 ≤ v_i).
 //!
 //! # Solution
 //!
