@@ -97,7 +97,7 @@ impl ObstacleFieldParams {
 
     /// σ_y (m).
     pub(crate) fn sigma_lateral_m(&self) -> f64 {
-        self.lateral_safety_m / (-2.0 * (self.epsilon / self.amplitude).ln()).sqrt()
+        self.lateral_safety_m / self.lateral_laplace_rate_per_m()
     }
 }
 

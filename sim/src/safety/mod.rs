@@ -370,8 +370,9 @@ impl SafetyMonitor {
     }
 
     /// The pairs (indices into `bodies`, i < j) followed at this instant, with their bounds, in
-    /// id order: from the X sweep, or from all pairs without the broad phase. `radii_m` holds
-    /// each body's bounding radius.
+    /// id order: from all pairs without the broad phase; with it, from every pair's X test up
+    /// to [`SMALL_FLEET`] bodies and from the X sweep beyond. `radii_m` holds each body's
+    /// bounding radius.
     fn followed_pairs(
         &self,
         bodies: &[BodyState],
@@ -385,25 +386,25 @@ impl SafetyMonitor {
             self.follows(bounds).then_some((i, j, bounds))
         };
         let n = bodies.len();
-        if self.params.broad_phase && n <= SMALL_FLEET {
-            // Every pair with the sweep's own X test, already in (i, j) order: the same pairs
-            // as the sweep (|x_j − x_i| is exactly antisymmetric), without its sorts.
-            let window_m = self.sweep_window_m(bodies);
-            return (0..n)
-                .flat_map(|i| ((i + 1)..n).map(move |j| (i, j)))
+        let all_pairs = (0..n).flat_map(|i| ((i + 1)..n).map(move |j| (i, j)));
+        if !self.params.broad_phase {
+            return all_pairs.filter_map(followed).collect();
+        }
+        let window_m = self.sweep_window_m(bodies);
+        if n <= SMALL_FLEET {
+            // The sweep's own X test on every pair, already in (i, j) order: the same pairs as
+            // the sweep (|x_j − x_i| is exactly antisymmetric), without its sorts.
+            return all_pairs
                 .filter(|&(i, j)| (bodies[j].x_m - bodies[i].x_m).abs() <= window_m)
                 .filter_map(followed)
                 .collect();
         }
-        let candidates: Vec<(usize, usize)> = if self.params.broad_phase {
-            let xs: Vec<f64> = bodies.iter().map(|b| b.x_m).collect();
-            XSweep::new(&xs).pairs_within_window(self.sweep_window_m(bodies))
-        } else {
-            (0..n)
-                .flat_map(|i| ((i + 1)..n).map(move |j| (i, j)))
-                .collect()
-        };
-        candidates.into_iter().filter_map(followed).collect()
+        let xs: Vec<f64> = bodies.iter().map(|b| b.x_m).collect();
+        XSweep::new(&xs)
+            .pairs_within_window(window_m)
+            .into_iter()
+            .filter_map(followed)
+            .collect()
     }
 
     /// An X distance beyond which no pair is followed (module doc): a followed pair has
