@@ -186,6 +186,44 @@ fn planning_on_a_given_pool_gives_the_same_bits() {
     assert_bitwise_equal(&reference, &on_pool);
 }
 
+/// Each vehicle's `plan_cycles` are its planner's cycles (they add up to the run's) and
+/// `path_fit_bound_cycles` those whose cubic fit (Eqs. 8–9) met a bound: tighter curvature
+/// bounds are met in more cycles, bounds no path comes near in none.
+#[test]
+fn each_vehicle_counts_the_cycles_whose_path_fit_met_a_bound() {
+    let scenario = Scenario::load("urgent_merge").unwrap();
+    let with_bounds = |curvature_per_m: f64, rate_per_m2: f64| {
+        let mut s = scenario.clone();
+        s.sim.planner.cubic_max_curvature_per_m = curvature_per_m;
+        s.sim.planner.cubic_max_curvature_rate_per_m2 = rate_per_m2;
+        run(&s, Some(PlannerKind::PfCs), false)
+    };
+    let bound_cycles = |outcome: &RunOutcome| -> u64 {
+        let planned: u64 = outcome.vehicles.iter().map(|v| v.plan_cycles).sum();
+        assert_eq!(planned, outcome.planner_stats.plans);
+        for v in &outcome.vehicles {
+            assert!(v.path_fit_bound_cycles <= v.plan_cycles, "{}", v.id);
+            let share = v.path_fit_bound_cycles as f64 / v.plan_cycles as f64;
+            assert_eq!(v.path_fit_bound_share, Some(share), "{}", v.id);
+        }
+        outcome
+            .vehicles
+            .iter()
+            .map(|v| v.path_fit_bound_cycles)
+            .sum()
+    };
+    let default = scenario.sim.planner.clone();
+    let nominal = bound_cycles(&with_bounds(
+        default.cubic_max_curvature_per_m,
+        default.cubic_max_curvature_rate_per_m2,
+    ));
+    let tight = bound_cycles(&with_bounds(1e-4, 1e-6));
+    let loose = bound_cycles(&with_bounds(1.0, 1.0));
+    assert!(tight > nominal, "tight {tight}, nominal {nominal}");
+    assert!(tight > 0);
+    assert!(loose <= nominal, "loose {loose}, nominal {nominal}");
+}
+
 /// `planner_stats.optimiser_*`: PF-CS solves no speed program; PF-ISO solves at least once per
 /// cycle; one SCP iteration of the Newton QP leaves some cycles at the cap, which more
 /// iterations reduce.

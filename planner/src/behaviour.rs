@@ -37,12 +37,14 @@ impl Behaviour for PfPlanner {
         })
     }
 
-    /// The speed optimisation of the last cycle (PF-CS has none: no solves).
+    /// The speed optimisation of the last cycle (PF-CS has none: no solves) and whether its
+    /// cubic fit (Eqs. 8–9) met a bound.
     fn optimiser_report(&self) -> Option<OptimiserReport> {
         let stats = self.last_stats();
         Some(OptimiserReport {
             solves: u32::try_from(stats.speed_solves).unwrap_or(u32::MAX),
             stopped_at_iteration_cap: stats.speed_stopped_at_iteration_cap,
+            path_fit_bound_active: stats.cubic_qp,
         })
     }
 

@@ -170,6 +170,18 @@ pub struct VehicleMetricsSummary {
     /// crossing); null when the metrics were made without a road.
     #[serde(default)]
     pub paper_metrics: Option<PaperMetricsSummary>,
+    /// Planning cycles of the vehicle's behaviour that count as planner cycles
+    /// (`Behaviour::is_planner`; 0 for a human-driver model or a recorded vehicle).
+    #[serde(default)]
+    pub plan_cycles: u64,
+    /// Of those, cycles whose path fit was limited by a bound
+    /// (`OptimiserReport::path_fit_bound_active`: the potential-field planners' cubic of
+    /// Eqs. 8–9 met its heading, curvature or curvature-rate bound).
+    #[serde(default)]
+    pub path_fit_bound_cycles: u64,
+    /// `path_fit_bound_cycles / plan_cycles`; null without a planning cycle.
+    #[serde(default)]
+    pub path_fit_bound_share: Option<f64>,
     /// The same figures as they stood at the run's first contact (vehicle–vehicle or road
     /// edge, any vehicle): over the samples logged before it, so a peak reached while or after
     /// the bodies touch does not enter. Absent (`None`) when the run had no contact: the
@@ -277,6 +289,8 @@ pub struct VehicleMetrics {
     accel_lat: SignalStats,
     collided: bool,
     paper: Option<PaperMetrics>,
+    plan_cycles: u64,
+    path_fit_bound_cycles: u64,
 }
 
 impl VehicleMetrics {
@@ -315,6 +329,8 @@ impl VehicleMetrics {
             accel_lat: SignalStats::default(),
             collided: false,
             paper: None,
+            plan_cycles: 0,
+            path_fit_bound_cycles: 0,
         }
     }
 
@@ -414,6 +430,13 @@ impl VehicleMetrics {
         Ok(())
     }
 
+    /// Counts one planning cycle of the vehicle's planner, and whether its path fit met a
+    /// bound (`OptimiserReport::path_fit_bound_active`).
+    pub fn push_plan_cycle(&mut self, path_fit_bound_active: bool) {
+        self.plan_cycles += 1;
+        self.path_fit_bound_cycles += u64::from(path_fit_bound_active);
+    }
+
     /// Number of samples so far.
     pub fn samples(&self) -> u64 {
         self.samples
@@ -470,6 +493,10 @@ impl VehicleMetrics {
             rms_jerk_lat_mps3,
             collided: self.collided,
             paper_metrics: self.paper.as_ref().map(PaperMetrics::summary),
+            plan_cycles: self.plan_cycles,
+            path_fit_bound_cycles: self.path_fit_bound_cycles,
+            path_fit_bound_share: (self.plan_cycles > 0)
+                .then(|| self.path_fit_bound_cycles as f64 / self.plan_cycles as f64),
             pre_contact: None,
         }
     }

@@ -5,7 +5,7 @@ use mergesim_types::VehicleId;
 
 use crate::error::SimError;
 use crate::metrics::{VehicleMetrics, VehicleMetricsSummary};
-use crate::observer::{TickObserver, VehicleView};
+use crate::observer::{PlanView, TickObserver, VehicleView};
 use crate::outcome::TimeSeriesRow;
 
 /// Metrics of every vehicle and the optional time series.
@@ -58,6 +58,14 @@ impl TickObserver for RunLog {
             if self.keep_time_series {
                 self.time_series.push(v.sample.clone());
             }
+        }
+        Ok(())
+    }
+
+    fn on_plan(&mut self, _t_s: f64, plan: &PlanView<'_, '_>) -> Result<(), SimError> {
+        // Only planner cycles are handed over (the world skips `is_planner() == false`).
+        if let Some(m) = self.metrics.get_mut(plan.observation.ego_id as usize) {
+            m.push_plan_cycle(plan.optimiser.is_some_and(|r| r.path_fit_bound_active));
         }
         Ok(())
     }

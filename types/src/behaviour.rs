@@ -156,6 +156,10 @@ pub struct OptimiserReport {
     pub solves: u32,
     /// Whether an iterative optimiser ran out of iterations before meeting its tolerance.
     pub stopped_at_iteration_cap: bool,
+    /// Whether the cycle's path fit was limited by one of its bounds (the potential-field
+    /// planners: the cubic of Eqs. 8–9 needed its QP because a heading, curvature or
+    /// curvature-rate bound was active); `false` for a planner without such a fit.
+    pub path_fit_bound_active: bool,
 }
 
 /// A vehicle's decision making (module doc). `Send` so the simulator may plan vehicles in
