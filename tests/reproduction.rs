@@ -205,7 +205,7 @@ fn check_mergesim_findings(p: Perturbation) -> bool {
         // and PF-CS's. PF-SP's peak sideslip is not asserted against PF-CS's: since path points
         // carry the speed of their own instant (2026-12-02) it lies above PF-CS's in 2 of the 6
         // variants where the obstacle makes room (ego 19 m/s: 0.000253 vs 0.000229 rad;
-        // obstacle 16 m/s: 0.000314 vs 0.000236 rad; CHANGELOG, docs/reproduction.md).
+        // obstacle 16 m/s: 0.000314 vs 0.000236 rad; CHANGELOG, docs/reproduction_history.md).
         for (k, (state, iso_value)) in motion_states(&iso).into_iter().enumerate() {
             let sp_value = motion_states(&sp)[k].1;
             let cs_value = motion_states(&cs)[k].1;
@@ -275,7 +275,7 @@ fn mergesim_set_worst_corner_only_the_planners_that_can_brake_avoid_the_collisio
 /// Where the two outcomes meet (obstacle start 45–53 m: first the obstacle makes room, then the
 /// ego yields): with roles fixed from the order now, neither PF-ISO nor PF-ISO-PRED collides
 /// (with per-slot roles on constant-velocity predictions PF-ISO-PRED raced into the obstacle at
-/// 47.2–50.8 m; docs/reproduction.md, "Where the two equilibria meet").
+/// 47.2–50.8 m; docs/reproduction_history.md, "Where the two equilibria meet").
 #[test]
 fn mergesim_set_switch_between_the_equilibria_is_collision_free_with_and_without_v2v() {
     for start_m in 45..=53 {

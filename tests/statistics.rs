@@ -91,7 +91,7 @@ fn pf_iso_is_collision_free_and_resolves_the_merge_by_speed_unlike_pf_cs() {
     // Not asserted: the paper (Sec. V, Figs. 7–9) has PF-CS with the largest sideslip, yaw and
     // yaw-rate peaks. For the peaks of `RunMetrics` (the largest of any vehicle, in practice the
     // ego's) that ordering does not hold on average over randomised instances: the ego's peak
-    // |r| is higher with PF-ISO (over the 200-run study of docs/reproduction.md,
+    // |r| is higher with PF-ISO (over the 200-run study now in docs/reproduction_history.md,
     // +0.00102 ± 0.00011 rad/s, lower on 37 of 200): with the obstacle further back, the ego
     // changes lanes in one quicker manoeuvre. The obstacle's own peaks do follow the paper: the
     // next test asserts it.

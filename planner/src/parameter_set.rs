@@ -20,7 +20,7 @@
 //! | `prediction` | `constant-velocity` | `lane-following` | a car 0.02 rad off the road axis is predicted a lane off after 160 m |
 //! | `v2v_loss_fallback` | `interact-with-predictions` | `risk-aware-following` | without any shared path the interaction term on predictions lets two cars side by side each expect the other to yield (the paper says nothing about losing V2V) |
 //!
-//! Each row's cost is measured in `docs/reproduction.md`.
+//! Each row's cost, measured on single runs, is in `docs/reproduction_history.md`.
 
 use std::str::FromStr;
 
