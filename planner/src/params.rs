@@ -228,8 +228,9 @@ pub struct PlannerParams {
     /// Clarabel's gap and feasibility tolerances.
     pub solver_tolerance: f64,
     /// How each SCP iteration's convex subproblem is posed: `cone` (the travel time exact, one
-    /// second-order cone per segment) or `newton-qp` (its second-order model: a QP, cheaper per
-    /// solve; default). See `speed_optimisation::SpeedProgram`.
+    /// second-order cone per segment), `newton-qp` (its second-order model: a QP, cheaper per
+    /// solve; default) or `newton-qp-banded` (the same QP by a banded interior-point method
+    /// instead of Clarabel; opt-in). See `speed_optimisation::SpeedProgram`.
     pub speed_program: SpeedProgram,
     /// A shared local path older than this is ignored in favour of a prediction (s).
     pub max_shared_path_age_s: f64,

@@ -71,6 +71,7 @@
 //! The non-convex term is any `SpeedTerm`: w3·Σ φ_i of PF-ISO (either reading of U_SLP), or
 //! w_R·Σ U_i of PF-SP's risk-aware speeds, with its own weight in `SpeedProblem`.
 
+pub(crate) mod banded_ipm;
 pub(crate) mod cone_program;
 pub(crate) mod fixed_waypoint_term;
 pub(crate) mod friction_limits;
@@ -102,6 +103,11 @@ pub enum SpeedProgram {
     /// optimum at 2–3× less cost per planning cycle (docs/parameters.md).
     #[default]
     NewtonQp,
+    /// The same Newton QP solved without Clarabel, by a primal–dual interior-point method on
+    /// its banded Newton system (`banded_ipm`): the same optimum to the solvers' tolerance
+    /// (not to the bit), at a fraction of the cost per solve. Opt-in; the acceptance
+    /// criterion and the measured agreement are in docs/parameters.md.
+    NewtonQpBanded,
 }
 
 /// The weights of J's convex part (module doc), built once from `PlannerParams`

@@ -246,6 +246,9 @@ impl SpeedOptimiser {
                 SpeedProgram::NewtonQp => self.solve_newton_qp(
                     params, layout, problem, &v, &g, &lo_k, &hi_k, accel_step, jerk_step,
                 ),
+                SpeedProgram::NewtonQpBanded => self.solve_newton_qp_banded(
+                    params, layout, problem, &v, &g, &lo_k, &hi_k, accel_step, jerk_step,
+                ),
             };
             let candidate = match solved {
                 Ok(candidate) => candidate,
@@ -355,7 +358,11 @@ mod tests {
 
     #[test]
     fn without_interaction_matches_the_per_waypoint_closed_form() {
-        for program in [SpeedProgram::Cone, SpeedProgram::NewtonQp] {
+        for program in [
+            SpeedProgram::Cone,
+            SpeedProgram::NewtonQp,
+            SpeedProgram::NewtonQpBanded,
+        ] {
             closed_form_case(program);
         }
     }
