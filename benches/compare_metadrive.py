@@ -95,6 +95,9 @@ def parse_args() -> argparse.Namespace:
                    help="MetaDrive processes run at once for the all-cores row (default: every core; "
                         "1 leaves the row out)")
     p.add_argument("--md-worker", action="store_true", help=argparse.SUPPRESS)
+    p.add_argument("--also-speed-program", default=None,
+                   help="also run the mergesim sweep with this [sim.planner] speed_program "
+                        "(e.g. newton-qp-banded), interleaved with the others")
     p.add_argument("--json", dest="json_path", default=None)
     a = p.parse_args()
     if min(a.reps, a.vehicles, a.sweep_runs, a.threads, a.md_episodes, a.md_max_steps, a.md_procs) < 1:
@@ -309,8 +312,10 @@ class MetaDrivePool:
 class MergeSim:
     """One `merge_sim run` or `merge_sim sweep` process per repetition."""
 
-    def __init__(self, bin_path: str, scenario: str, out: str, kind: str, args: argparse.Namespace) -> None:
+    def __init__(self, bin_path: str, scenario: str, out: str, kind: str, args: argparse.Namespace,
+                 key: str | None = None, note: str = "") -> None:
         self.kind = kind
+        self.key = key or kind
         self.out = out
         self.env = dict(os.environ)
         if kind == "run1":
@@ -325,7 +330,7 @@ class MergeSim:
             self.cmd = [bin_path, "sweep", "--scenario", scenario, "--runs", str(args.sweep_runs),
                         "--threads", str(args.threads), "--seed", "42", "--json", out, "--quiet"]
             self.env.pop("RAYON_NUM_THREADS", None)
-            self.label = f"mergesim `sweep` of {args.sweep_runs}, {args.threads} threads"
+            self.label = f"mergesim `sweep` of {args.sweep_runs}, {args.threads} threads{note}"
         self.duration_s: float | None = None  # set from a `run` JSON (sweep JSON has no duration)
 
     def run(self) -> dict:
@@ -406,12 +411,24 @@ def main() -> int:
         raise SystemExit(f"merge_sim scenario platoon failed: {toml.stderr}")
     with open(scenario, "w", encoding="utf-8") as f:
         f.write(toml.stdout)
+    alt_scenario = None
+    if args.also_speed_program:
+        if "[sim.planner]" in toml.stdout or "\n[sim.road]" not in toml.stdout:
+            raise SystemExit("internal: cannot place [sim.planner] in the generated platoon scenario")
+        alt_scenario = os.path.join(tmp, f"platoon_merge_{args.vehicles}_{args.also_speed_program}.toml")
+        with open(alt_scenario, "w", encoding="utf-8") as f:
+            f.write(toml.stdout.replace(
+                "\n[sim.road]",
+                f'\n[sim.planner]\nspeed_program = "{args.also_speed_program}"\n\n[sim.road]', 1))
 
     log("creating the MetaDrive env (untimed) ...")
     mdv = MetaDrive(args)
     ms = [MergeSim(args.bin, scenario, os.path.join(tmp, f"{k}.json"), k, args) for k in ("run1", "run", "sweep")]
+    if alt_scenario:
+        ms.append(MergeSim(args.bin, alt_scenario, os.path.join(tmp, "sweep_alt.json"), "sweep", args,
+                           key="sweep_alt", note=f", speed_program {args.also_speed_program}"))
     pool = MetaDrivePool(args) if args.md_procs > 1 else None
-    variants: list = [("md", mdv)] + ([("md_pool", pool)] if pool else []) + [(m.kind, m) for m in ms]
+    variants: list = [("md", mdv)] + ([("md_pool", pool)] if pool else []) + [(m.key, m) for m in ms]
     try:
         log("warm-up (untimed): every MetaDrive scenario's reset + one episode, one run of each mergesim variant")
         mdv.warm_up()
@@ -482,7 +499,7 @@ def main() -> int:
             ("md_all", mdv.label_all, f"≤ {mds[0]['max_vehicles_all']} (mean {summ['md_all']['vehicle_s_per_rep'] / summ['md_all']['sim_s_per_rep']:.1f})")]
     if pool:
         rows.append(("md_pool", pool.label, f"1–{mds[0]['max_vehicles']} per process"))
-    rows += [(m.kind, m.label, "/".join(str(n) for n in samples[m.kind][0]["vehicles"])) for m in ms]
+    rows += [(m.key, m.label, "/".join(str(n) for n in samples[m.key][0]["vehicles"])) for m in ms]
     for key, label, veh in rows:
         s = summ[key]
         rate = f"{fmt(s['rate_median'])} ({fmt(s['rate_min'])}–{fmt(s['rate_max'])})"
@@ -507,6 +524,10 @@ def main() -> int:
         out.append("")
         out.append(f"Every core on both sides: mergesim `sweep` / MetaDrive {args.md_procs} processes = "
                    f"{both:.2f} (medians of the main column).")
+        if "sweep_alt" in summ:
+            alt = summ["sweep_alt"]["rate_median"] / summ["md_pool"]["rate_median"]
+            out.append(f"With speed_program {args.also_speed_program}: mergesim `sweep` / MetaDrive "
+                       f"{args.md_procs} processes = {alt:.2f}.")
     print("\n".join(out), file=report, flush=True)
 
     if args.json_path:

@@ -31,7 +31,8 @@
 # Needs bash, python3 (with venv/ensurepip), pip access to PyPI (no other network access).
 #
 # Usage: benches/compare_metadrive.sh [--reps N] [--vehicles N] [--sweep-runs K] [--threads T]
-#                                     [--md-episodes N] [--md-procs P] [--json PATH] [--bin PATH] [--build] [--help]
+#                                     [--md-episodes N] [--md-procs P] [--also-speed-program NAME]
+#                                     [--json PATH] [--bin PATH] [--build] [--help]
 set -euo pipefail
 
 METADRIVE_PIN="metadrive-simulator==0.4.3"
@@ -54,6 +55,9 @@ Options:
   --sweep-runs K    instances per `merge_sim sweep` repetition (default 4)
   --threads T       worker threads of the sweep (default: every core)
   --md-episodes N   MetaDrive episodes per repetition (default 10, seeds 0..N-1)
+  --also-speed-program NAME
+                    also run the mergesim sweep with this [sim.planner] speed_program
+                    (e.g. newton-qp-banded), interleaved with the other variants
   --md-procs P      MetaDrive processes run at once for the all-cores row (default: every
                     core; 1 leaves the row out)
   --json PATH       also write all samples and the environment as JSON
@@ -73,6 +77,7 @@ threads=""
 md_episodes=10
 md_procs=""
 json=""
+also_program=""
 bin=""
 build=0
 need() { [[ $# -ge 2 && -n $2 ]] || { echo "error: $1 needs a value" >&2; exit 2; }; }
@@ -85,6 +90,7 @@ while [[ $# -gt 0 ]]; do
     --threads) need "$@"; posint "$1" "$2"; threads=$2; shift 2 ;;
     --md-episodes) need "$@"; posint "$1" "$2"; md_episodes=$2; shift 2 ;;
     --md-procs) need "$@"; posint "$1" "$2"; md_procs=$2; shift 2 ;;
+    --also-speed-program) need "$@"; also_program=$2; shift 2 ;;
     --json) need "$@"; json=$2; shift 2 ;;
     --bin) need "$@"; bin=$2; shift 2 ;;
     --build) build=1; shift ;;
@@ -149,4 +155,5 @@ args=(--bin "$bin" --root "$root" --reps "$reps" --vehicles "$vehicles" --sweep-
 if [[ -n $threads ]]; then args+=(--threads "$threads"); fi
 if [[ -n $md_procs ]]; then args+=(--md-procs "$md_procs"); fi
 if [[ -n $json ]]; then args+=(--json "$json"); fi
+if [[ -n $also_program ]]; then args+=(--also-speed-program "$also_program"); fi
 exec "$py" "$root/benches/compare_metadrive.py" "${args[@]}"
