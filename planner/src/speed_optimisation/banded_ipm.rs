@@ -76,10 +76,11 @@ fn cholesky_in_place(band: &mut Band) -> bool {
             }
             band[i][off] = sum / band[j][0];
         }
-        let mut diag = band[i][0];
-        for off in 1..=2 {
+        let row = band[i];
+        let mut diag = row[0];
+        for (off, l) in row.iter().enumerate().skip(1) {
             if i >= off {
-                diag -= band[i][off] * band[i][off];
+                diag -= l * l;
             }
         }
         if !diag.is_finite() || diag <= 0.0 {
@@ -371,6 +372,7 @@ mod tests {
     use super::*;
 
     /// A small dense reference: M x = b by Gaussian elimination.
+    #[allow(clippy::needless_range_loop)]
     fn dense_solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
         let n = b.len();
         for c in 0..n {

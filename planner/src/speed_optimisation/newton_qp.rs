@@ -31,7 +31,7 @@ use clarabel::solver::{DefaultSolver, NonnegativeConeT, SupportedConeT};
 use super::banded_ipm::BandedQp;
 use super::cone_program::{Layout, PROBLEM};
 use super::scp::SpeedOptimiser;
-use super::{SpeedOptimiserParams, SpeedProblem};
+use super::{SpeedOptimiserParams, SpeedProblem, SpeedProgram};
 use crate::clarabel_setup::{new_solver, solve_checked, solver_failed};
 use crate::error::PlannerError;
 
@@ -70,7 +70,8 @@ impl Layout {
 impl SpeedOptimiser {
     /// One solve of the Newton QP (module doc) expanded at `at` (v̄, every entry > 0), with
     /// the non-convex term linearised to `gradient` (already × its weight) and the box
-    /// [lo, hi]. Returns v_1..v_N.
+    /// [lo, hi], by Clarabel or, with `speed_program = "newton-qp-banded"`, by the banded
+    /// interior-point method of [`banded_ipm`](super::banded_ipm). Returns v_1..v_N.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn solve_newton_qp(
         &mut self,
@@ -95,6 +96,20 @@ impl SpeedOptimiser {
             return Err(PlannerError::NonFinite {
                 what: "speed_optimisation QP data".into(),
             });
+        }
+        if params.program == SpeedProgram::NewtonQpBanded {
+            // The same QP by the banded interior-point method (`banded_ipm`), with the same
+            // iteration cap and tolerance.
+            let qp = BandedQp {
+                h: &h,
+                q: &q,
+                lo,
+                hi,
+                accel_step: layout.accel.then_some(accel_step),
+                jerk_step: layout.jerk.then_some(jerk_step),
+            };
+            let x = qp.solve(params.solver.max_iterations, params.solver.tolerance)?;
+            return Ok(snap_onto_box(&x, lo, hi));
         }
 
         let tolerance_bits = params.solver.tolerance.to_bits();
@@ -131,48 +146,6 @@ impl SpeedOptimiser {
         };
         let x = solve_checked(&mut cached.solver, PROBLEM, n)?;
         Ok(snap_onto_box(x, lo, hi))
-    }
-
-    /// The same Newton QP as [`Self::solve_newton_qp`], solved by the banded interior-point
-    /// method of [`banded_ipm`](super::banded_ipm) instead of Clarabel (`speed_program =
-    /// "newton-qp-banded"`), with the same iteration cap and tolerance.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn solve_newton_qp_banded(
-        &mut self,
-        params: &SpeedOptimiserParams,
-        layout: Layout,
-        problem: &SpeedProblem<'_>,
-        at: &[f64],
-        gradient: &[f64],
-        lo: &[f64],
-        hi: &[f64],
-        accel_step: f64,
-        jerk_step: f64,
-    ) -> Result<Vec<f64>, PlannerError> {
-        let (h, q) = newton_model(params, problem, at, gradient, layout.n);
-        let data_finite = h
-            .iter()
-            .chain(&q)
-            .chain(lo)
-            .chain(hi)
-            .all(|v| v.is_finite())
-            && accel_step.is_finite()
-            && jerk_step.is_finite();
-        if at.iter().any(|v| *v <= 0.0) || !data_finite {
-            return Err(PlannerError::NonFinite {
-                what: "speed_optimisation QP data".into(),
-            });
-        }
-        let qp = BandedQp {
-            h: &h,
-            q: &q,
-            lo,
-            hi,
-            accel_step: layout.accel.then_some(accel_step),
-            jerk_step: layout.jerk.then_some(jerk_step),
-        };
-        let x = qp.solve(params.solver.max_iterations, params.solver.tolerance)?;
-        Ok(snap_onto_box(&x, lo, hi))
     }
 }
 

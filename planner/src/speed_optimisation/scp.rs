@@ -243,10 +243,7 @@ impl SpeedOptimiser {
                 SpeedProgram::Cone => self.solve_convex(
                     params, layout, problem, &g, &lo_k, &hi_k, accel_step, jerk_step,
                 ),
-                SpeedProgram::NewtonQp => self.solve_newton_qp(
-                    params, layout, problem, &v, &g, &lo_k, &hi_k, accel_step, jerk_step,
-                ),
-                SpeedProgram::NewtonQpBanded => self.solve_newton_qp_banded(
+                SpeedProgram::NewtonQp | SpeedProgram::NewtonQpBanded => self.solve_newton_qp(
                     params, layout, problem, &v, &g, &lo_k, &hi_k, accel_step, jerk_step,
                 ),
             };
