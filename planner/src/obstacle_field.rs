@@ -201,17 +201,26 @@ impl ObstacleField {
     }
 
     /// The exponent q (U = A·exp(−q)) and ∂q/∂x, ∂q/∂y and ∂q/∂σ_x of the point's side.
+    ///
+    /// Inlined so that a caller that needs only q (or only q and ∇q) does not pay for the
+    /// divisions of the rest. The side is read off the along-coordinate computed here, the
+    /// same number [`side`](Self::side) computes.
+    #[inline(always)]
     fn exponent_and_derivatives(&self, x_m: f64, y_m: f64) -> (f64, [f64; 2], f64) {
         let dx = x_m - self.x_m;
         let dy = y_m - self.y_m;
-        let sx = match self.side(x_m, y_m) {
-            Side::Front => self.sigma_front_m,
-            Side::Rear => self.sigma_rear_m,
+        let sigma_x = |along: f64| {
+            if along >= 0.0 {
+                self.sigma_front_m
+            } else {
+                self.sigma_rear_m
+            }
         };
         let sy = self.sigma_lateral_m;
         match self.heading_form {
             HeadingForm::Rotation => {
                 let ux = self.cos_heading * dx + self.sin_heading * dy;
+                let sx = sigma_x(ux);
                 let uy = -self.sin_heading * dx + self.cos_heading * dy;
                 // The lateral half: u_y²/σ_y², or k·|u_y| as printed (LateralForm).
                 let (lateral, qy) = match self.lateral_form {
@@ -235,6 +244,7 @@ impl ObstacleField {
                 // In the lane's axes (identity on a road along +x).
                 let [lc, ls] = self.lane_axes;
                 let (dx, dy) = (lc * dx + ls * dy, -ls * dx + lc * dy);
+                let sx = sigma_x(dx);
                 let psi = self.heading_rad;
                 let c1 = 1.0 - psi * psi;
                 match self.lateral_form {
@@ -268,16 +278,19 @@ impl ObstacleField {
 
     /// The exponent q with U = A·exp(−q) (q ≥ 0, except in the printed Laplace form with the
     /// correlation form, where C2 can make it negative near the centre: U > A there).
+    #[inline]
     pub(crate) fn exponent(&self, x_m: f64, y_m: f64) -> f64 {
         self.exponent_and_derivatives(x_m, y_m).0
     }
 
     /// U_OB at (x, y), Eq. 4.
+    #[inline]
     pub(crate) fn value(&self, x_m: f64, y_m: f64) -> f64 {
         self.amplitude * (-self.exponent(x_m, y_m)).exp()
     }
 
     /// U_OB and its gradient with respect to the evaluated point (x, y).
+    #[inline]
     pub(crate) fn value_and_gradient(&self, x_m: f64, y_m: f64) -> (f64, [f64; 2]) {
         let (q, dq, _) = self.exponent_and_derivatives(x_m, y_m);
         let u = self.amplitude * (-q).exp();

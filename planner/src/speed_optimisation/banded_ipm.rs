@@ -141,59 +141,99 @@ struct Blocks {
     jerk: usize,
 }
 
+/// The six blocks of a stacked row vector, in [`Blocks`]' order.
+struct Parts<T> {
+    hi: T,
+    lo: T,
+    accel_plus: T,
+    accel_minus: T,
+    jerk_plus: T,
+    jerk_minus: T,
+}
+
 impl Blocks {
-    const HI: usize = 0;
-    fn lo(&self) -> usize {
-        self.n
-    }
-    fn accel_plus(&self) -> usize {
-        2 * self.n
-    }
-    fn accel_minus(&self) -> usize {
-        2 * self.n + self.accel
-    }
-    fn jerk_plus(&self) -> usize {
-        2 * self.n + 2 * self.accel
-    }
-    fn jerk_minus(&self) -> usize {
-        2 * self.n + 2 * self.accel + self.jerk
-    }
     fn rows(&self) -> usize {
         2 * self.n + 2 * self.accel + 2 * self.jerk
     }
 
+    /// The blocks of `x` (of length [`rows`](Self::rows)).
+    fn split<'a>(&self, x: &'a [f64]) -> Parts<&'a [f64]> {
+        let (hi, rest) = x.split_at(self.n);
+        let (lo, rest) = rest.split_at(self.n);
+        let (accel_plus, rest) = rest.split_at(self.accel);
+        let (accel_minus, rest) = rest.split_at(self.accel);
+        let (jerk_plus, rest) = rest.split_at(self.jerk);
+        let jerk_minus = &rest[..self.jerk];
+        Parts {
+            hi,
+            lo,
+            accel_plus,
+            accel_minus,
+            jerk_plus,
+            jerk_minus,
+        }
+    }
+
+    /// The blocks of `x` (of length [`rows`](Self::rows)), mutable.
+    fn split_mut<'a>(&self, x: &'a mut [f64]) -> Parts<&'a mut [f64]> {
+        let (hi, rest) = x.split_at_mut(self.n);
+        let (lo, rest) = rest.split_at_mut(self.n);
+        let (accel_plus, rest) = rest.split_at_mut(self.accel);
+        let (accel_minus, rest) = rest.split_at_mut(self.accel);
+        let (jerk_plus, rest) = rest.split_at_mut(self.jerk);
+        let jerk_minus = &mut rest[..self.jerk];
+        Parts {
+            hi,
+            lo,
+            accel_plus,
+            accel_minus,
+            jerk_plus,
+            jerk_minus,
+        }
+    }
+
     /// out = G v.
     fn apply(&self, v: &[f64], out: &mut [f64]) {
-        let n = self.n;
-        for i in 0..n {
-            out[Self::HI + i] = v[i];
-            out[self.lo() + i] = -v[i];
+        let out = self.split_mut(out);
+        for ((hi, lo), x) in out.hi.iter_mut().zip(out.lo.iter_mut()).zip(v) {
+            *hi = *x;
+            *lo = -*x;
         }
-        for i in 0..self.accel {
-            let d = v[i + 1] - v[i];
-            out[self.accel_plus() + i] = d;
-            out[self.accel_minus() + i] = -d;
+        for ((plus, minus), pair) in out
+            .accel_plus
+            .iter_mut()
+            .zip(out.accel_minus.iter_mut())
+            .zip(v.windows(2))
+        {
+            let d = pair[1] - pair[0];
+            *plus = d;
+            *minus = -d;
         }
-        for i in 0..self.jerk {
-            let e = v[i + 2] - 2.0 * v[i + 1] + v[i];
-            out[self.jerk_plus() + i] = e;
-            out[self.jerk_minus() + i] = -e;
+        for ((plus, minus), triple) in out
+            .jerk_plus
+            .iter_mut()
+            .zip(out.jerk_minus.iter_mut())
+            .zip(v.windows(3))
+        {
+            let e = triple[2] - 2.0 * triple[1] + triple[0];
+            *plus = e;
+            *minus = -e;
         }
     }
 
     /// out += Gᵀ y.
     fn add_transposed(&self, y: &[f64], out: &mut [f64]) {
-        let n = self.n;
-        for i in 0..n {
-            out[i] += y[Self::HI + i] - y[self.lo() + i];
+        let y = self.split(y);
+        for ((o, plus), minus) in out.iter_mut().zip(y.hi).zip(y.lo) {
+            *o += plus - minus;
         }
-        for i in 0..self.accel {
-            let c = y[self.accel_plus() + i] - y[self.accel_minus() + i];
+        for (i, (plus, minus)) in y.accel_plus.iter().zip(y.accel_minus).enumerate() {
+            let c = plus - minus;
             out[i + 1] += c;
             out[i] -= c;
         }
-        for i in 0..self.jerk {
-            let c = y[self.jerk_plus() + i] - y[self.jerk_minus() + i];
+        for (i, (plus, minus)) in y.jerk_plus.iter().zip(y.jerk_minus).enumerate() {
+            let c = plus - minus;
             out[i + 2] += c;
             out[i + 1] -= 2.0 * c;
             out[i] += c;
@@ -202,25 +242,72 @@ impl Blocks {
 
     /// band = diag(h) + Gᵀ diag(w) G (lower band, bandwidth 2).
     fn normal_matrix(&self, h: &[f64], w: &[f64], band: &mut Band) {
-        let n = self.n;
-        for i in 0..n {
-            band[i] = [h[i] + w[Self::HI + i] + w[self.lo() + i], 0.0, 0.0];
+        let w = self.split(w);
+        for (((row, hi), w_hi), w_lo) in band.iter_mut().zip(h).zip(w.hi).zip(w.lo) {
+            *row = [hi + w_hi + w_lo, 0.0, 0.0];
         }
-        for i in 0..self.accel {
-            let wi = w[self.accel_plus() + i] + w[self.accel_minus() + i];
+        for (i, (plus, minus)) in w.accel_plus.iter().zip(w.accel_minus).enumerate() {
+            let wi = plus + minus;
             band[i][0] += wi;
             band[i + 1][0] += wi;
             band[i + 1][1] -= wi;
         }
-        for i in 0..self.jerk {
+        for (i, (plus, minus)) in w.jerk_plus.iter().zip(w.jerk_minus).enumerate() {
             // Row coefficients (1, −2, 1) on (i, i+1, i+2).
-            let wi = w[self.jerk_plus() + i] + w[self.jerk_minus() + i];
+            let wi = plus + minus;
             band[i][0] += wi;
             band[i + 1][0] += 4.0 * wi;
             band[i + 2][0] += wi;
             band[i + 1][1] -= 2.0 * wi;
             band[i + 2][1] -= 2.0 * wi;
             band[i + 2][2] += wi;
+        }
+    }
+}
+
+/// The per-iteration data both Newton directions share (module doc): Z r_p, S⁻¹, the
+/// residuals and the factor of M.
+struct NewtonSystem<'a> {
+    blocks: Blocks,
+    r_d: &'a [f64],
+    r_p: &'a [f64],
+    z: &'a [f64],
+    z_r_p: &'a [f64],
+    inv_s: &'a [f64],
+    band: &'a Band,
+}
+
+impl NewtonSystem<'_> {
+    /// The direction for the complementarity target r_c (s∘z − σμ + corrections):
+    ///   Δv = M⁻¹ (−r_d − Gᵀ S⁻¹ (Z r_p − r_c)),
+    ///   Δs = −r_p − G Δv,   Δz = −S⁻¹ (r_c + Z Δs).
+    /// `y` is scratch of the rows' length.
+    fn direction(
+        &self,
+        r_c: &[f64],
+        y: &mut [f64],
+        dv: &mut [f64],
+        ds: &mut [f64],
+        dz: &mut [f64],
+    ) {
+        for (d, r) in dv.iter_mut().zip(self.r_d) {
+            *d = -r;
+        }
+        for (((y, rc), zr), inv) in y.iter_mut().zip(r_c).zip(self.z_r_p).zip(self.inv_s) {
+            *y = (rc - zr) * inv;
+        }
+        self.blocks.add_transposed(y, dv);
+        cholesky_solve(self.band, dv);
+        self.blocks.apply(dv, ds);
+        for ((((ds, dz), rp), rc), (z, inv)) in ds
+            .iter_mut()
+            .zip(dz.iter_mut())
+            .zip(self.r_p)
+            .zip(r_c)
+            .zip(self.z.iter().zip(self.inv_s))
+        {
+            *ds = -rp - *ds;
+            *dz = -(rc + z * *ds) * inv;
         }
     }
 }
@@ -283,6 +370,7 @@ impl BandedQp<'_> {
 
         let mut r_d = vec![0.0; n];
         let mut r_p = vec![0.0; m];
+        let mut z_r_p = vec![0.0; m];
         let mut w = vec![0.0; m];
         let mut inv_s = vec![0.0; m];
         let mut y = vec![0.0; m];
@@ -293,17 +381,25 @@ impl BandedQp<'_> {
         let mut r_c = vec![0.0; m];
         for _ in 0..max_iterations {
             // Residuals: r_d = H v + q + Gᵀ z, r_p = G v + s − g.
-            for i in 0..n {
-                r_d[i] = self.h[i] * v[i] + self.q[i];
+            for ((r, (h, q)), x) in r_d.iter_mut().zip(self.h.iter().zip(self.q)).zip(&v) {
+                *r = h * x + q;
             }
             blocks.add_transposed(&z, &mut r_d);
             blocks.apply(&v, &mut gv);
-            let mut gap = 0.0;
-            for k in 0..m {
-                r_p[k] = gv[k] + s[k] - g[k];
-                gap += s[k] * z[k];
-                inv_s[k] = 1.0 / s[k];
-                w[k] = z[k] * inv_s[k];
+            for (((r, gv), s), g) in r_p.iter_mut().zip(&gv).zip(&s).zip(&g) {
+                *r = gv + s - g;
+            }
+            let gap = s.iter().zip(&z).fold(0.0, |gap, (s, z)| gap + s * z);
+            for ((((inv, w), zr), s), (z, rp)) in inv_s
+                .iter_mut()
+                .zip(w.iter_mut())
+                .zip(z_r_p.iter_mut())
+                .zip(&s)
+                .zip(z.iter().zip(&r_p))
+            {
+                *inv = 1.0 / s;
+                *w = z * *inv;
+                *zr = z * rp;
             }
             let mu = gap / m as f64;
             if !mu.is_finite() || v.iter().any(|x| !x.is_finite()) {
@@ -320,47 +416,43 @@ impl BandedQp<'_> {
             if !cholesky_in_place(&mut band) {
                 return Err(failed("Newton system not positive definite"));
             }
-            // One direction for the complementarity target r_c (s∘z − σμ + corrections):
-            //   Δv = M⁻¹ (−r_d − Gᵀ S⁻¹ (Z r_p − r_c)),
-            //   Δs = −r_p − G Δv,   Δz = −S⁻¹ (r_c + Z Δs).
-            let mut direction = |r_c: &[f64], dv: &mut [f64], ds: &mut [f64], dz: &mut [f64]| {
-                for i in 0..n {
-                    dv[i] = -r_d[i];
-                }
-                for k in 0..m {
-                    y[k] = (r_c[k] - z[k] * r_p[k]) * inv_s[k];
-                }
-                blocks.add_transposed(&y, dv);
-                cholesky_solve(&band, dv);
-                blocks.apply(dv, ds);
-                for k in 0..m {
-                    ds[k] = -r_p[k] - ds[k];
-                    dz[k] = -(r_c[k] + z[k] * ds[k]) * inv_s[k];
-                }
+            let system = NewtonSystem {
+                blocks,
+                r_d: &r_d,
+                r_p: &r_p,
+                z: &z,
+                z_r_p: &z_r_p,
+                inv_s: &inv_s,
+                band: &band,
             };
             // Predictor (affine scaling).
-            for k in 0..m {
-                r_c[k] = s[k] * z[k];
+            for ((rc, s), z) in r_c.iter_mut().zip(&s).zip(&z) {
+                *rc = s * z;
             }
-            direction(&r_c, &mut dv, &mut ds, &mut dz);
+            system.direction(&r_c, &mut y, &mut dv, &mut ds, &mut dz);
             let alpha_aff = step_to_boundary(&s, &ds).min(step_to_boundary(&z, &dz));
-            let mu_aff = (0..m)
-                .map(|k| (s[k] + alpha_aff * ds[k]) * (z[k] + alpha_aff * dz[k]))
+            let mu_aff = s
+                .iter()
+                .zip(&ds)
+                .zip(z.iter().zip(&dz))
+                .map(|((s, ds), (z, dz))| (s + alpha_aff * ds) * (z + alpha_aff * dz))
                 .sum::<f64>()
                 / m as f64;
             let sigma = (mu_aff / mu).powi(3);
             // Corrector (centring and second-order term).
-            for k in 0..m {
-                r_c[k] = s[k] * z[k] + ds[k] * dz[k] - sigma * mu;
+            for ((rc, (s, z)), (ds, dz)) in
+                r_c.iter_mut().zip(s.iter().zip(&z)).zip(ds.iter().zip(&dz))
+            {
+                *rc = s * z + ds * dz - sigma * mu;
             }
-            direction(&r_c, &mut dv, &mut ds, &mut dz);
+            system.direction(&r_c, &mut y, &mut dv, &mut ds, &mut dz);
             let alpha = (0.99 * step_to_boundary(&s, &ds).min(step_to_boundary(&z, &dz))).min(1.0);
-            for i in 0..n {
-                v[i] += alpha * dv[i];
+            for (x, d) in v.iter_mut().zip(&dv) {
+                *x += alpha * d;
             }
-            for k in 0..m {
-                s[k] += alpha * ds[k];
-                z[k] += alpha * dz[k];
+            for ((s, z), (ds, dz)) in s.iter_mut().zip(z.iter_mut()).zip(ds.iter().zip(&dz)) {
+                *s += alpha * ds;
+                *z += alpha * dz;
             }
         }
         Err(failed("max iterations"))

@@ -123,6 +123,28 @@ impl SpeedTerm for InteractionTerm {
         }
         (value, gradient)
     }
+
+    /// Σ_i φ_i(v) without the gradient: the SCP's line search evaluates the objective far more
+    /// often than its gradient. The same operations in the same order as
+    /// [`value_and_gradient`](Self::value_and_gradient), so the same bits.
+    fn value(&self, speeds_mps: &[f64]) -> f64 {
+        let n = speeds_mps.len().min(self.fields.len());
+        let mut value = 0.0;
+        let mut s = 0.0;
+        for i in 0..n {
+            s += speeds_mps[i] * self.step_time_s;
+            let p = self.path.point_and_tangent(s, self.fallback_tangent).0;
+            let mut sum_u = 0.0;
+            for field in &self.fields[i] {
+                sum_u += field.value(p[0], p[1]);
+            }
+            match self.aggregate {
+                Aggregate::LogFloored { floor } => value += ((floor + sum_u) / floor).ln(),
+                Aggregate::Linear => value += sum_u,
+            }
+        }
+        value
+    }
 }
 
 #[cfg(test)]
@@ -175,6 +197,11 @@ mod tests {
         );
         let v: Vec<f64> = (0..n).map(|i| 14.0 + 0.1 * i as f64).collect();
         let g = super::super::assert_gradient_matches_central_differences(&term, &v);
+        // The value-only evaluation is the same computation: the same bits.
+        assert_eq!(
+            term.value(&v).to_bits(),
+            term.value_and_gradient(&v).0.to_bits()
+        );
         assert!(
             g.iter().any(|gi| gi.abs() > 1e-3),
             "the term must act: {g:?}"
