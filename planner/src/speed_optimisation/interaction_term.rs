@@ -128,14 +128,13 @@ impl SpeedTerm for InteractionTerm {
     /// often than its gradient. The same operations in the same order as
     /// [`value_and_gradient`](Self::value_and_gradient), so the same bits.
     fn value(&self, speeds_mps: &[f64]) -> f64 {
-        let n = speeds_mps.len().min(self.fields.len());
         let mut value = 0.0;
         let mut s = 0.0;
-        for i in 0..n {
-            s += speeds_mps[i] * self.step_time_s;
+        for (speed_mps, fields) in speeds_mps.iter().zip(&self.fields) {
+            s += speed_mps * self.step_time_s;
             let p = self.path.point_and_tangent(s, self.fallback_tangent).0;
             let mut sum_u = 0.0;
-            for field in &self.fields[i] {
+            for field in fields {
                 sum_u += field.value(p[0], p[1]);
             }
             match self.aggregate {
