@@ -26,12 +26,16 @@
 #                                         requires the default ground texture to exist (it is only
 #                                         loaded when rendering)
 # A real asset download (`python -m metadrive.pull_asset`) is left alone: existing files are kept.
+# --md-traffic-density D sets MetaDrive's traffic_density; 0.2 is the smallest density (in steps
+# of 0.05) with at least 10 driving vehicles on average, the matched comparison planned in
+# benches/metadrive_matched_density.md.
 # The merge_sim binary: --bin PATH, else target/release/merge_sim, built
 # (`cargo build --release --bin merge_sim`) if missing or with --build.
 # Needs bash, python3 (with venv/ensurepip), pip access to PyPI (no other network access).
 #
 # Usage: benches/compare_metadrive.sh [--reps N] [--vehicles N] [--sweep-runs K] [--threads T]
-#                                     [--md-episodes N] [--md-procs P] [--also-speed-program NAME]
+#                                     [--md-episodes N] [--md-procs P] [--md-traffic-density D]
+#                                     [--also-speed-program NAME]
 #                                     [--json PATH] [--bin PATH] [--build] [--help]
 set -euo pipefail
 
@@ -60,6 +64,10 @@ Options:
                     (e.g. newton-qp-banded), interleaved with the other variants
   --md-procs P      MetaDrive processes run at once for the all-cores row (default: every
                     core; 1 leaves the row out)
+  --md-traffic-density D
+                    MetaDrive's traffic_density, a number in (0, 1] (default: MetaDrive's own,
+                    0.1: 5.5 driving vehicles on average over the 10 episodes; 0.2: 11.4, the
+                    matched comparison of benches/metadrive_matched_density.md)
   --json PATH       also write all samples and the environment as JSON
   --bin PATH        merge_sim binary to use (default target/release/merge_sim, built if missing)
   --build           run `cargo build --release --bin merge_sim` even if the binary exists
@@ -76,6 +84,7 @@ sweep_runs=4
 threads=""
 md_episodes=10
 md_procs=""
+md_density=""
 json=""
 also_program=""
 bin=""
@@ -90,6 +99,9 @@ while [[ $# -gt 0 ]]; do
     --threads) need "$@"; posint "$1" "$2"; threads=$2; shift 2 ;;
     --md-episodes) need "$@"; posint "$1" "$2"; md_episodes=$2; shift 2 ;;
     --md-procs) need "$@"; posint "$1" "$2"; md_procs=$2; shift 2 ;;
+    --md-traffic-density) need "$@"
+      [[ $2 =~ ^(0?\.[0-9]*[1-9][0-9]*|1(\.0*)?)$ ]] || { echo "error: --md-traffic-density must be a number in (0, 1], got '$2'" >&2; exit 2; }
+      md_density=$2; shift 2 ;;
     --also-speed-program) need "$@"; also_program=$2; shift 2 ;;
     --json) need "$@"; json=$2; shift 2 ;;
     --bin) need "$@"; bin=$2; shift 2 ;;
@@ -154,6 +166,7 @@ args=(--bin "$bin" --root "$root" --reps "$reps" --vehicles "$vehicles" --sweep-
       --md-episodes "$md_episodes")
 if [[ -n $threads ]]; then args+=(--threads "$threads"); fi
 if [[ -n $md_procs ]]; then args+=(--md-procs "$md_procs"); fi
+if [[ -n $md_density ]]; then args+=(--md-traffic-density "$md_density"); fi
 if [[ -n $json ]]; then args+=(--json "$json"); fi
 if [[ -n $also_program ]]; then args+=(--also-speed-program "$also_program"); fi
 exec "$py" "$root/benches/compare_metadrive.py" "${args[@]}"
