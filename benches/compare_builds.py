@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Paired wall-clock comparison of two merge_sim builds on the same command.
 
-Runs `OLD ARGS...` and `NEW ARGS...` alternately (old, new, old, new, ...; the first pair
-untimed as a warm-up), times each whole process, and prints the median of the per-pair ratios
-new / old with its range, beside each build's median wall time. Pairing keeps the ratio
+Runs `OLD ARGS...` and `NEW ARGS...` in pairs, the order swapped from pair to pair (old then
+new, new then old, ...) so that a position effect (warm caches, clock boost) does not favour
+one build; the first pair is an untimed warm-up. Times each whole process and prints the median
+of the per-pair ratios new / old with its range, beside each build's median wall time. Pairing keeps the ratio
 meaningful when the machine's speed drifts during the comparison (it does: the same binary has
 run 1.6x slower in an evening than in a morning on the development machine).
 
@@ -83,9 +84,19 @@ def main():
         walls = {"old": [], "new": []}
         for rep in range(a.reps + 1):
             pair = {}
-            for name, binary in (("old", a.old), ("new", a.new)):
+            order = [("old", a.old), ("new", a.new)]
+            if rep % 2 == 0:
+                order.reverse()
+            for name, binary in order:
+                if os.path.exists(outs[name]):
+                    os.remove(outs[name])  # a run that writes nothing is not compared stale
                 pair[name] = run_once(binary, args, outs[name])
             if a.same_results:
+                for name in outs:
+                    if not os.path.isfile(outs[name]):
+                        print(f"error: pair {rep}: the {name} build wrote no {{out}} file",
+                              file=sys.stderr)
+                        sys.exit(1)
                 with open(outs["old"]) as f_old, open(outs["new"]) as f_new:
                     if strip_wall_clock(json.load(f_old)) != strip_wall_clock(json.load(f_new)):
                         print(f"error: pair {rep}: the two builds' results differ", file=sys.stderr)
