@@ -91,6 +91,18 @@ pub(crate) enum Side {
     Rear,
 }
 
+impl Side {
+    /// The side of a point `along` metres ahead of the obstacle along its axis (NaN: rear).
+    #[inline]
+    fn of_along(along: f64) -> Self {
+        if along >= 0.0 {
+            Side::Front
+        } else {
+            Side::Rear
+        }
+    }
+}
+
 impl ObstacleField {
     /// The field of a vehicle at (x, y, ψ) with `other_speed_mps` and `other_shape`, seen by
     /// the planning vehicle `me` (σ's as in the module doc).
@@ -193,10 +205,15 @@ impl ObstacleField {
                 self.lane_axes[0] * dx + self.lane_axes[1] * (y_m - self.y_m)
             }
         };
-        if along >= 0.0 {
-            Side::Front
-        } else {
-            Side::Rear
+        Side::of_along(along)
+    }
+
+    /// σ_x of `side` (m).
+    #[inline]
+    fn sigma_x_m(&self, side: Side) -> f64 {
+        match side {
+            Side::Front => self.sigma_front_m,
+            Side::Rear => self.sigma_rear_m,
         }
     }
 
@@ -209,18 +226,11 @@ impl ObstacleField {
     fn exponent_and_derivatives(&self, x_m: f64, y_m: f64) -> (f64, [f64; 2], f64) {
         let dx = x_m - self.x_m;
         let dy = y_m - self.y_m;
-        let sigma_x = |along: f64| {
-            if along >= 0.0 {
-                self.sigma_front_m
-            } else {
-                self.sigma_rear_m
-            }
-        };
         let sy = self.sigma_lateral_m;
         match self.heading_form {
             HeadingForm::Rotation => {
                 let ux = self.cos_heading * dx + self.sin_heading * dy;
-                let sx = sigma_x(ux);
+                let sx = self.sigma_x_m(Side::of_along(ux));
                 let uy = -self.sin_heading * dx + self.cos_heading * dy;
                 // The lateral half: u_y²/σ_y², or k·|u_y| as printed (LateralForm).
                 let (lateral, qy) = match self.lateral_form {
@@ -244,7 +254,7 @@ impl ObstacleField {
                 // In the lane's axes (identity on a road along +x).
                 let [lc, ls] = self.lane_axes;
                 let (dx, dy) = (lc * dx + ls * dy, -ls * dx + lc * dy);
-                let sx = sigma_x(dx);
+                let sx = self.sigma_x_m(Side::of_along(dx));
                 let psi = self.heading_rad;
                 let c1 = 1.0 - psi * psi;
                 match self.lateral_form {
