@@ -73,3 +73,31 @@ def provenance(root: str, binary: str, packages: dict) -> dict:
         "merge_sim_version": cmd_out([binary, "--version"]),
         "merge_sim_binary_mtime": built_s,
     }
+
+
+# The [sim] periods a scenario leaves at their defaults must each be at least one physics step;
+# only the safety checks' (0.01 s) can be shorter than the steps the benches use (up to 0.02 s).
+DEFAULT_SAFETY_PERIOD_S = 0.01
+
+
+def with_physics_step(scenario_toml: str, dt_s: float) -> str:
+    """`scenario_toml` (a generated scenario with a `dt_s = ...` line in its [sim] table and no
+    `safety_period_s`) with the physics step `dt_s`; where the default safety-check period would
+    be shorter than one step, the checks run every step (`safety_period_s = dt_s`). Raises
+    ValueError if the text does not have that form."""
+    lines = scenario_toml.split("\n")
+    try:
+        sim = lines.index("[sim]")
+    except ValueError:
+        raise ValueError("the scenario has no [sim] table") from None
+    if any(line.startswith("safety_period_s") for line in lines):
+        raise ValueError("the scenario sets safety_period_s itself")
+    for i in range(sim + 1, len(lines)):
+        if lines[i].startswith("["):
+            break
+        if lines[i].startswith("dt_s ="):
+            lines[i] = f"dt_s = {dt_s!r}"
+            if dt_s > DEFAULT_SAFETY_PERIOD_S:
+                lines.insert(i + 1, f"safety_period_s = {dt_s!r}")
+            return "\n".join(lines)
+    raise ValueError("the scenario's [sim] table has no dt_s line")

@@ -38,7 +38,8 @@ and this is a throughput comparison, not a like-for-like one:
     mergesim's `sweep` (one MetaDrive process uses one core).
   * mergesim: the platoon of `platoon_merge_50` with --vehicles N cars (`merge_sim scenario
     platoon --vehicles N`, the scale scenarios of the README's scaling table; N = 10: 5 per lane
-    at 20 m/s zipping into one lane, 72 s): Rapier rigid-body vehicles stepped at 500 Hz with
+    at 20 m/s zipping into one lane, 72 s): Rapier rigid-body vehicles stepped at 500 Hz (or at
+    --dt-s: the physics steps at which the vehicle is valid, benches/physics_step_validity.py) with
     tire forces, each re-planning at 10 Hz with PF-ISO (potential field + Clarabel QPs) against
     the others in range, V2V, tracking, safety metrics and the JSON summary. Vehicle-seconds =
     vehicles x duration_s. Three variants:
@@ -66,6 +67,7 @@ import importlib.metadata as md
 import json
 import logging
 import os
+import re
 import resource
 import statistics
 import subprocess
@@ -73,7 +75,7 @@ import sys
 import tempfile
 import time
 
-from bench_common import loadavg, log, provenance
+from bench_common import loadavg, log, provenance, with_physics_step
 
 
 def parse_args() -> argparse.Namespace:
@@ -95,6 +97,8 @@ def parse_args() -> argparse.Namespace:
                    help="MetaDrive processes run at once for the all-cores row (default: every core; "
                         "1 leaves the row out)")
     p.add_argument("--md-worker", action="store_true", help=argparse.SUPPRESS)
+    p.add_argument("--dt-s", type=float, default=None,
+                   help="physics step of the mergesim platoon, [sim] dt_s (default: the scenario's, 0.002 s)")
     p.add_argument("--also-speed-program", default=None,
                    help="also run the mergesim sweep with this [sim.planner] speed_program "
                         "(e.g. newton-qp-banded), interleaved with the others")
@@ -409,6 +413,14 @@ def main() -> int:
                           capture_output=True, text=True)
     if toml.returncode != 0:
         raise SystemExit(f"merge_sim scenario platoon failed: {toml.stderr}")
+    if args.dt_s is not None:
+        toml.stdout = with_physics_step(toml.stdout, args.dt_s)
+    step = re.search(r"(?m)^dt_s = (\S+)$", toml.stdout)
+    if step is None:
+        raise SystemExit("internal: the generated platoon scenario has no dt_s line")
+    physics_dt_s = float(step.group(1))
+    physics_hz = 1.0 / physics_dt_s
+    env_info["mergesim_dt_s"] = physics_dt_s
     with open(scenario, "w", encoding="utf-8") as f:
         f.write(toml.stdout)
     alt_scenario = None
@@ -489,7 +501,8 @@ def main() -> int:
                + f"; at most {mds[0]['max_vehicles']} vehicles driving, {mds[0]['max_vehicles_all']} in the Bullet world"
                + (f"; {mds[0]['capped']} hit the safety cap" if mds[0]["capped"] else ""))
     out.append(f"- mergesim: `merge_sim scenario platoon --vehicles {args.vehicles}` (platoon_merge_{args.vehicles}), "
-               f"{ms[0].duration_s:g} s simulated per run, PF-ISO, 500 Hz Rapier; sweep: {args.sweep_runs} randomised "
+               f"{ms[0].duration_s:g} s simulated per run, PF-ISO, {physics_hz:g} Hz Rapier "
+               f"(dt_s {physics_dt_s:g} s{', set by --dt-s' if args.dt_s is not None else ''}); sweep: {args.sweep_runs} randomised "
                f"instances (--seed 42) on {args.threads} threads")
     out.append("")
     out.append("| run | vehicles | simulated s / rep | vehicle-s / rep | vehicle-s per wall s, median (min–max) "

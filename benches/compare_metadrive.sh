@@ -29,13 +29,15 @@
 # --md-traffic-density D sets MetaDrive's traffic_density; 0.2 is the smallest density (in steps
 # of 0.05) with at least 10 driving vehicles on average, the matched comparison planned in
 # benches/metadrive_matched_density.md.
+# --dt-s DT sets the mergesim platoon's physics step ([sim] dt_s; default 0.002 s): the steps at
+# which the vehicle is valid are measured by benches/physics_step_validity.py.
 # The merge_sim binary: --bin PATH, else target/release/merge_sim, built
 # (`cargo build --release --bin merge_sim`) if missing or with --build.
 # Needs bash, python3 (with venv/ensurepip), pip access to PyPI (no other network access).
 #
 # Usage: benches/compare_metadrive.sh [--reps N] [--vehicles N] [--sweep-runs K] [--threads T]
 #                                     [--md-episodes N] [--md-procs P] [--md-traffic-density D]
-#                                     [--also-speed-program NAME]
+#                                     [--dt-s DT] [--also-speed-program NAME]
 #                                     [--json PATH] [--bin PATH] [--build] [--help]
 set -euo pipefail
 
@@ -59,6 +61,9 @@ Options:
   --sweep-runs K    instances per `merge_sim sweep` repetition (default 4)
   --threads T       worker threads of the sweep (default: every core)
   --md-episodes N   MetaDrive episodes per repetition (default 10, seeds 0..N-1)
+  --dt-s DT         physics step of the mergesim platoon in seconds, [sim] dt_s, in
+                    [0.0001, 0.02] (default: the scenario's, 0.002 s = 500 Hz). Which steps keep
+                    the vehicle valid: benches/physics_step_validity.py
   --also-speed-program NAME
                     also run the mergesim sweep with this [sim.planner] speed_program
                     (e.g. newton-qp-banded), interleaved with the other variants
@@ -85,6 +90,7 @@ threads=""
 md_episodes=10
 md_procs=""
 md_density=""
+dt_s=""
 json=""
 also_program=""
 bin=""
@@ -102,6 +108,10 @@ while [[ $# -gt 0 ]]; do
     --md-traffic-density) need "$@"
       [[ $2 =~ ^(0?\.[0-9]*[1-9][0-9]*|1(\.0*)?)$ ]] || { echo "error: --md-traffic-density must be a number in (0, 1], got '$2'" >&2; exit 2; }
       md_density=$2; shift 2 ;;
+    --dt-s) need "$@"
+      [[ $2 =~ ^0?\.[0-9]+$ ]] && awk -v d="$2" 'BEGIN { exit !(d >= 0.0001 && d <= 0.02) }' \
+        || { echo "error: --dt-s must be a number of seconds in [0.0001, 0.02], got '$2'" >&2; exit 2; }
+      dt_s=$2; shift 2 ;;
     --also-speed-program) need "$@"; also_program=$2; shift 2 ;;
     --json) need "$@"; json=$2; shift 2 ;;
     --bin) need "$@"; bin=$2; shift 2 ;;
@@ -167,6 +177,7 @@ args=(--bin "$bin" --root "$root" --reps "$reps" --vehicles "$vehicles" --sweep-
 if [[ -n $threads ]]; then args+=(--threads "$threads"); fi
 if [[ -n $md_procs ]]; then args+=(--md-procs "$md_procs"); fi
 if [[ -n $md_density ]]; then args+=(--md-traffic-density "$md_density"); fi
+if [[ -n $dt_s ]]; then args+=(--dt-s "$dt_s"); fi
 if [[ -n $json ]]; then args+=(--json "$json"); fi
 if [[ -n $also_program ]]; then args+=(--also-speed-program "$also_program"); fi
 exec "$py" "$root/benches/compare_metadrive.py" "${args[@]}"

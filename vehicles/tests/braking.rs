@@ -1,6 +1,8 @@
 //! Straight-line braking against the friction-limited distance v²/(2μg) and, with locked
 //! wheels, against the Magic Formula's sliding friction.
 
+mod validation_step;
+
 use vehicles::maneuver::{ManeuverConfig, ManeuverKind, run_maneuver};
 use vehicles::{GRAVITY_MPS2, PRESET_NAMES, TireParams, VehicleParams};
 
@@ -15,6 +17,7 @@ fn braking(vehicle_params: VehicleParams, name: &str, speed_mps: f64, mu: f64) -
         duration_s: 20.0,
         step_time_s: 0.5,
         trace_period_s: 0.0,
+        dt_s: validation_step::validation_dt_s(),
         ..ManeuverConfig::default()
     };
     let report = run_maneuver(&cfg).unwrap();

@@ -1,6 +1,8 @@
 //! Steady-state cornering against the linear single-track model (closed forms in
 //! `vehicles::single_track`) and against the quasi-static roll equation.
 
+mod validation_step;
+
 use vehicles::maneuver::{ManeuverConfig, ManeuverKind, ManeuverReport, run_maneuver};
 use vehicles::{GRAVITY_MPS2, LinearSingleTrack, PRESET_NAMES, VehicleParams};
 
@@ -12,6 +14,7 @@ fn steady_state(vehicle: &str, speed_mps: f64, steer_rad: f64) -> ManeuverReport
         steer_rad,
         mu: 0.9,
         trace_period_s: 0.0,
+        dt_s: validation_step::validation_dt_s(),
         ..ManeuverConfig::default()
     };
     run_maneuver(&cfg).unwrap()
@@ -140,6 +143,7 @@ fn lateral_acceleration_saturates_at_friction_limit() {
             steer_rad: 2.0 * mu * GRAVITY_MPS2 * 2.58 / 400.0,
             mu,
             trace_period_s: 0.0,
+            dt_s: validation_step::validation_dt_s(),
             ..ManeuverConfig::default()
         };
         let report = run_maneuver(&cfg).unwrap();
