@@ -191,6 +191,15 @@ fn bad_input_exits_2_naming_the_value_and_writes_nothing() {
             "NaN",
         ),
         (
+            vec![
+                "maneuver".into(),
+                "braking".into(),
+                "--trace-period-s".into(),
+                "-0.02".into(),
+            ],
+            "trace_period_s",
+        ),
+        (
             vec!["run".into(), "--json".into(), "/no/such/dir/x.json".into()],
             "/no/such/dir",
         ),
@@ -241,6 +250,60 @@ fn scenario_show_reads_back_unchanged() {
     assert_eq!(a, b);
     let list = merge_sim(&["scenario", "list"]);
     assert!(String::from_utf8_lossy(&list.stdout).contains("urgent_merge"));
+}
+
+/// `--trace-period-s` spaces the trace (rounded to whole steps of `--dt-s`), 0 drops it.
+#[test]
+fn maneuver_trace_period_sets_the_trace_spacing() {
+    let dir = scratch("maneuver_trace");
+    let json = dir.join("m.json");
+    let trace_times = |period: &str| -> Vec<f64> {
+        let out = merge_sim(&[
+            "maneuver",
+            "step-steer",
+            "--dt-s",
+            "0.0025",
+            "--trace-period-s",
+            period,
+            "--json",
+            json.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        v["trace"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s["t_s"].as_f64().unwrap())
+            .collect()
+    };
+    let times = trace_times("0.02");
+    assert!(times.len() > 100, "{}", times.len());
+    for pair in times.windows(2) {
+        assert!((pair[1] - pair[0] - 0.02).abs() < 1e-9, "{pair:?}");
+    }
+    // The default (0.05 s) gives fewer samples; 0 gives none.
+    let default_len = {
+        let out = merge_sim(&[
+            "maneuver",
+            "step-steer",
+            "--dt-s",
+            "0.0025",
+            "--json",
+            json.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        v["trace"].as_array().unwrap().len()
+    };
+    assert!(
+        default_len * 2 < times.len(),
+        "{default_len} vs {}",
+        times.len()
+    );
+    assert!(trace_times("0").is_empty());
 }
 
 #[test]

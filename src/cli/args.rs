@@ -6,6 +6,7 @@ use std::sync::Arc;
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 use planner::ParameterSet;
 use sim::registry::BehaviourRegistry;
+use vehicles::maneuver::ManeuverConfig;
 
 /// Cooperative merge simulator: potential-field planners with interactive speed optimisation
 /// (Lin et al.) on physics-based Rapier vehicles.
@@ -293,8 +294,12 @@ pub(crate) struct ManeuverArgs {
     #[arg(long, default_value_t = 0.02, allow_negative_numbers = true)]
     pub(crate) steer_rad: f64,
     /// Physics step (s).
-    #[arg(long, default_value_t = 0.002, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = ManeuverConfig::default().dt_s, allow_negative_numbers = true)]
     pub(crate) dt_s: f64,
+    /// Period of the report's `trace` (s), rounded to whole physics steps (at least one); 0
+    /// records no trace.
+    #[arg(long, default_value_t = ManeuverConfig::default().trace_period_s, allow_negative_numbers = true)]
+    pub(crate) trace_period_s: f64,
     /// Write the report as JSON here.
     #[arg(long, value_name = "PATH")]
     pub(crate) json: Option<PathBuf>,

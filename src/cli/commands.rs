@@ -142,6 +142,7 @@ pub(crate) fn cmd_maneuver(args: &ManeuverArgs) -> Result<(), Failure> {
         steer_rad: args.steer_rad,
         mu: args.mu,
         dt_s: args.dt_s,
+        trace_period_s: args.trace_period_s,
         ..ManeuverConfig::default()
     };
     config.validate().map_err(input)?;
