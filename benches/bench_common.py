@@ -101,3 +101,18 @@ def with_physics_step(scenario_toml: str, dt_s: float) -> str:
                 lines.insert(i + 1, f"safety_period_s = {dt_s!r}")
             return "\n".join(lines)
     raise ValueError("the scenario's [sim] table has no dt_s line")
+
+
+def parse_steps(text: str) -> list[float]:
+    """A comma-separated list of physics steps in seconds, each within the physics world's
+    range [0.0001, 0.02] s; raises ValueError naming the bad entry."""
+    steps = []
+    for item in text.split(","):
+        try:
+            dt = float(item)
+        except ValueError:
+            raise ValueError(f"'{item}' is not a number of seconds") from None
+        if not (1e-4 <= dt <= 0.02):
+            raise ValueError(f"{item} s is outside [0.0001, 0.02] s, the physics world's range")
+        steps.append(dt)
+    return steps

@@ -33,7 +33,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_common import log, provenance  # noqa: E402
+from bench_common import log, parse_steps, provenance  # noqa: E402
 
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 REFERENCE_DT_S = 0.001
@@ -55,15 +55,10 @@ def parse_args() -> argparse.Namespace:
     p.add_argument("--trace-period-s", type=float, default=0.02)
     p.add_argument("--bin", default=os.path.join(ROOT, "target", "release", "merge_sim"))
     args = p.parse_args()
-    args.steps = []
-    for text in args.dt.split(","):
-        try:
-            dt = float(text)
-        except ValueError:
-            p.error(f"--dt: '{text}' is not a number of seconds")
-        if not (1e-4 <= dt <= 0.02):
-            p.error(f"--dt: {text} s is outside [0.0001, 0.02] s, the physics world's range")
-        args.steps.append(dt)
+    try:
+        args.steps = parse_steps(args.dt)
+    except ValueError as e:
+        p.error(f"--dt: {e}")
     if not (args.trace_period_s > 0.0):
         p.error("--trace-period-s must be > 0")
     if not os.access(args.bin, os.X_OK):

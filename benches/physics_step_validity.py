@@ -41,7 +41,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_common import log, provenance, with_physics_step  # noqa: E402
+from bench_common import log, parse_steps, provenance, with_physics_step  # noqa: E402
 
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 DT_ENV = "MERGESIM_VALIDATION_DT_S"
@@ -57,16 +57,10 @@ def parse_args() -> argparse.Namespace:
     p.add_argument("--bin", default=None, help="merge_sim binary (default target/release/merge_sim)")
     p.add_argument("--json", dest="json_path", default=None, help="also write the results as JSON")
     args = p.parse_args()
-    steps = []
-    for text in args.dt.split(","):
-        try:
-            dt = float(text)
-        except ValueError:
-            p.error(f"--dt: '{text}' is not a number of seconds")
-        if not (1e-4 <= dt <= 0.02):
-            p.error(f"--dt: {text} s is outside [0.0001, 0.02] s, the physics world's range")
-        steps.append(dt)
-    args.steps = steps
+    try:
+        args.steps = parse_steps(args.dt)
+    except ValueError as e:
+        p.error(f"--dt: {e}")
     if args.vehicles < 1 or args.sweep_runs < 1:
         p.error("--vehicles and --sweep-runs must be positive")
     if args.bin is None:

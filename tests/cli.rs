@@ -257,17 +257,14 @@ fn scenario_show_reads_back_unchanged() {
 fn maneuver_trace_period_sets_the_trace_spacing() {
     let dir = scratch("maneuver_trace");
     let json = dir.join("m.json");
-    let trace_times = |period: &str| -> Vec<f64> {
-        let out = merge_sim(&[
-            "maneuver",
-            "step-steer",
-            "--dt-s",
-            "0.0025",
-            "--trace-period-s",
-            period,
-            "--json",
-            json.to_str().unwrap(),
-        ]);
+    // The trace's times with `--trace-period-s period`, or with the default period.
+    let trace_times = |period: Option<&str>| -> Vec<f64> {
+        let mut args = vec!["maneuver", "step-steer", "--dt-s", "0.0025"];
+        if let Some(period) = period {
+            args.extend(["--trace-period-s", period]);
+        }
+        args.extend(["--json", json.to_str().unwrap()]);
+        let out = merge_sim(&args);
         assert!(out.status.success(), "{}", stderr(&out));
         let v: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
@@ -278,32 +275,19 @@ fn maneuver_trace_period_sets_the_trace_spacing() {
             .map(|s| s["t_s"].as_f64().unwrap())
             .collect()
     };
-    let times = trace_times("0.02");
+    let times = trace_times(Some("0.02"));
     assert!(times.len() > 100, "{}", times.len());
     for pair in times.windows(2) {
         assert!((pair[1] - pair[0] - 0.02).abs() < 1e-9, "{pair:?}");
     }
     // The default (0.05 s) gives fewer samples; 0 gives none.
-    let default_len = {
-        let out = merge_sim(&[
-            "maneuver",
-            "step-steer",
-            "--dt-s",
-            "0.0025",
-            "--json",
-            json.to_str().unwrap(),
-        ]);
-        assert!(out.status.success(), "{}", stderr(&out));
-        let v: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-        v["trace"].as_array().unwrap().len()
-    };
+    let default_len = trace_times(None).len();
     assert!(
         default_len * 2 < times.len(),
         "{default_len} vs {}",
         times.len()
     );
-    assert!(trace_times("0").is_empty());
+    assert!(trace_times(Some("0")).is_empty());
 }
 
 #[test]
