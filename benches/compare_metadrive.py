@@ -413,23 +413,23 @@ def main() -> int:
                           capture_output=True, text=True)
     if toml.returncode != 0:
         raise SystemExit(f"merge_sim scenario platoon failed: {toml.stderr}")
-    if args.dt_s is not None:
-        toml.stdout = with_physics_step(toml.stdout, args.dt_s)
-    step = re.search(r"(?m)^dt_s = (\S+)$", toml.stdout)
+    # The generated platoon, with --dt-s's physics step if given.
+    text = toml.stdout if args.dt_s is None else with_physics_step(toml.stdout, args.dt_s)
+    step = re.search(r"(?m)^dt_s = (\S+)$", text)
     if step is None:
         raise SystemExit("internal: the generated platoon scenario has no dt_s line")
     physics_dt_s = float(step.group(1))
     physics_hz = 1.0 / physics_dt_s
     env_info["mergesim_dt_s"] = physics_dt_s
     with open(scenario, "w", encoding="utf-8") as f:
-        f.write(toml.stdout)
+        f.write(text)
     alt_scenario = None
     if args.also_speed_program:
-        if "[sim.planner]" in toml.stdout or "\n[sim.road]" not in toml.stdout:
+        if "[sim.planner]" in text or "\n[sim.road]" not in text:
             raise SystemExit("internal: cannot place [sim.planner] in the generated platoon scenario")
         alt_scenario = os.path.join(tmp, f"platoon_merge_{args.vehicles}_{args.also_speed_program}.toml")
         with open(alt_scenario, "w", encoding="utf-8") as f:
-            f.write(toml.stdout.replace(
+            f.write(text.replace(
                 "\n[sim.road]",
                 f'\n[sim.planner]\nspeed_program = "{args.also_speed_program}"\n\n[sim.road]', 1))
 
