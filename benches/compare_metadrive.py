@@ -50,6 +50,9 @@ and this is a throughput comparison, not a like-for-like one:
       - `sweep`, all cores: `merge_sim sweep --scenario P --runs K --threads T --seed 42 --json
         OUT --quiet`, K randomised instances of the platoon (its [randomise] ranges) on T worker
         threads (default: every core); vehicle-seconds summed over the completed runs.
+    With --also-planner NAME, the `run` on one core and the `sweep` also run with `--planner NAME`
+    (every vehicle), e.g. idm-mobil: IDM + MOBIL, the kind of driver MetaDrive's IDMPolicy is, so
+    the simulator's cost can be read apart from PF-ISO's planning.
     Timed: the whole merge_sim process, measured here around the subprocess (process start-up,
     scenario parsing and JSON writing included: conservative for mergesim); the JSON's
     in-process `wall_time_s` is the second column.
@@ -102,6 +105,10 @@ def parse_args() -> argparse.Namespace:
     p.add_argument("--also-speed-program", default=None,
                    help="also run the mergesim sweep with this [sim.planner] speed_program "
                         "(e.g. newton-qp-banded), interleaved with the others")
+    p.add_argument("--also-planner", default=None,
+                   help="also run the mergesim `run` on one core and the `sweep` with this planner in "
+                        "place of PF-ISO (`--planner NAME`, e.g. idm-mobil: MetaDrive's kind of driver), "
+                        "interleaved with the others")
     p.add_argument("--json", dest="json_path", default=None)
     a = p.parse_args()
     if min(a.reps, a.vehicles, a.sweep_runs, a.threads, a.md_episodes, a.md_max_steps, a.md_procs) < 1:
@@ -317,7 +324,7 @@ class MergeSim:
     """One `merge_sim run` or `merge_sim sweep` process per repetition."""
 
     def __init__(self, bin_path: str, scenario: str, out: str, kind: str, args: argparse.Namespace,
-                 key: str | None = None, note: str = "") -> None:
+                 key: str | None = None, note: str = "", extra: tuple[str, ...] = ()) -> None:
         self.kind = kind
         self.key = key or kind
         self.out = out
@@ -325,7 +332,7 @@ class MergeSim:
         if kind == "run1":
             self.cmd = [bin_path, "run", "--scenario", scenario, "--no-rrd", "--json", out, "--quiet"]
             self.env["RAYON_NUM_THREADS"] = "1"
-            self.label = f"mergesim `run`, one core (RAYON_NUM_THREADS=1)"
+            self.label = "mergesim `run`, one core (RAYON_NUM_THREADS=1)"
         elif kind == "run":
             self.cmd = [bin_path, "run", "--scenario", scenario, "--no-rrd", "--json", out, "--quiet"]
             self.env.pop("RAYON_NUM_THREADS", None)
@@ -335,6 +342,9 @@ class MergeSim:
                         "--threads", str(args.threads), "--seed", "42", "--json", out, "--quiet"]
             self.env.pop("RAYON_NUM_THREADS", None)
             self.label = f"mergesim `sweep` of {args.sweep_runs}, {args.threads} threads{note}"
+        if kind == "run1" and note:
+            self.label += note
+        self.cmd += list(extra)
         self.duration_s: float | None = None  # set from a `run` JSON (sweep JSON has no duration)
 
     def run(self) -> dict:
@@ -433,12 +443,31 @@ def main() -> int:
                 "\n[sim.road]",
                 f'\n[sim.planner]\nspeed_program = "{args.also_speed_program}"\n\n[sim.road]', 1))
 
+    if args.also_planner:
+        # Refused before any MetaDrive work: an unknown name, or one the platoon cannot run.
+        check = subprocess.run([args.bin, "run", "--scenario", scenario, "--planner", args.also_planner,
+                                "--duration", "0.1", "--no-rrd", "--quiet"], capture_output=True, text=True)
+        if check.returncode != 0:
+            print(f"error: --also-planner {args.also_planner}: merge_sim refused it:\n{check.stderr.strip()}",
+                  file=sys.stderr)
+            for name in os.listdir(tmp):
+                os.remove(os.path.join(tmp, name))
+            os.rmdir(tmp)
+            return 2
+
     log("creating the MetaDrive env (untimed) ...")
     mdv = MetaDrive(args)
     ms = [MergeSim(args.bin, scenario, os.path.join(tmp, f"{k}.json"), k, args) for k in ("run1", "run", "sweep")]
     if alt_scenario:
         ms.append(MergeSim(args.bin, alt_scenario, os.path.join(tmp, "sweep_alt.json"), "sweep", args,
                            key="sweep_alt", note=f", speed_program {args.also_speed_program}"))
+    if args.also_planner:
+        extra = ("--planner", args.also_planner)
+        note = f", planner {args.also_planner}"
+        ms.append(MergeSim(args.bin, scenario, os.path.join(tmp, "run1_planner.json"), "run1", args,
+                           key="run1_planner", note=note, extra=extra))
+        ms.append(MergeSim(args.bin, scenario, os.path.join(tmp, "sweep_planner.json"), "sweep", args,
+                           key="sweep_planner", note=note, extra=extra))
     pool = MetaDrivePool(args) if args.md_procs > 1 else None
     variants: list = [("md", mdv)] + ([("md_pool", pool)] if pool else []) + [(m.key, m) for m in ms]
     try:
@@ -503,7 +532,9 @@ def main() -> int:
     out.append(f"- mergesim: `merge_sim scenario platoon --vehicles {args.vehicles}` (platoon_merge_{args.vehicles}), "
                f"{ms[0].duration_s:g} s simulated per run, PF-ISO, {physics_hz:g} Hz Rapier "
                f"(dt_s {physics_dt_s:g} s{', set by --dt-s' if args.dt_s is not None else ''}); sweep: {args.sweep_runs} randomised "
-               f"instances (--seed 42) on {args.threads} threads")
+               f"instances (--seed 42) on {args.threads} threads"
+               + (f"; rows marked \"planner {args.also_planner}\": the same commands with `--planner "
+                  f"{args.also_planner}` (every vehicle)" if args.also_planner else ""))
     out.append("")
     out.append("| run | vehicles | simulated s / rep | vehicle-s / rep | vehicle-s per wall s, median (min–max) "
                "| inner timer, median (min–max) | CPU / wall | ratio to MetaDrive (medians) |")
@@ -540,6 +571,10 @@ def main() -> int:
         if "sweep_alt" in summ:
             alt = summ["sweep_alt"]["rate_median"] / summ["md_pool"]["rate_median"]
             out.append(f"With speed_program {args.also_speed_program}: mergesim `sweep` / MetaDrive "
+                       f"{args.md_procs} processes = {alt:.2f}.")
+        if "sweep_planner" in summ:
+            alt = summ["sweep_planner"]["rate_median"] / summ["md_pool"]["rate_median"]
+            out.append(f"With planner {args.also_planner} in place of PF-ISO: mergesim `sweep` / MetaDrive "
                        f"{args.md_procs} processes = {alt:.2f}.")
     print("\n".join(out), file=report, flush=True)
 

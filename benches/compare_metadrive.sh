@@ -37,7 +37,7 @@
 #
 # Usage: benches/compare_metadrive.sh [--reps N] [--vehicles N] [--sweep-runs K] [--threads T]
 #                                     [--md-episodes N] [--md-procs P] [--md-traffic-density D]
-#                                     [--dt-s DT] [--also-speed-program NAME]
+#                                     [--dt-s DT] [--also-speed-program NAME] [--also-planner NAME]
 #                                     [--json PATH] [--bin PATH] [--build] [--help]
 set -euo pipefail
 
@@ -67,6 +67,11 @@ Options:
   --also-speed-program NAME
                     also run the mergesim sweep with this [sim.planner] speed_program
                     (e.g. newton-qp-banded), interleaved with the other variants
+  --also-planner NAME
+                    also run the mergesim `run` on one core and the `sweep` with `--planner NAME`
+                    (every vehicle) in place of PF-ISO, interleaved with the other variants:
+                    e.g. idm-mobil (IDM + MOBIL, the kind of driver MetaDrive's IDMPolicy is), to
+                    separate the simulator's cost from the planner's. An unknown name: exit 2
   --md-procs P      MetaDrive processes run at once for the all-cores row (default: every
                     core; 1 leaves the row out)
   --md-traffic-density D
@@ -93,6 +98,7 @@ md_density=""
 dt_s=""
 json=""
 also_program=""
+also_planner=""
 bin=""
 build=0
 need() { [[ $# -ge 2 && -n $2 ]] || { echo "error: $1 needs a value" >&2; exit 2; }; }
@@ -113,6 +119,7 @@ while [[ $# -gt 0 ]]; do
         || { echo "error: --dt-s must be a number of seconds in [0.0001, 0.02], got '$2'" >&2; exit 2; }
       dt_s=$2; shift 2 ;;
     --also-speed-program) need "$@"; also_program=$2; shift 2 ;;
+    --also-planner) need "$@"; also_planner=$2; shift 2 ;;
     --json) need "$@"; json=$2; shift 2 ;;
     --bin) need "$@"; bin=$2; shift 2 ;;
     --build) build=1; shift ;;
@@ -180,4 +187,5 @@ if [[ -n $md_density ]]; then args+=(--md-traffic-density "$md_density"); fi
 if [[ -n $dt_s ]]; then args+=(--dt-s "$dt_s"); fi
 if [[ -n $json ]]; then args+=(--json "$json"); fi
 if [[ -n $also_program ]]; then args+=(--also-speed-program "$also_program"); fi
+if [[ -n $also_planner ]]; then args+=(--also-planner "$also_planner"); fi
 exec "$py" "$root/benches/compare_metadrive.py" "${args[@]}"
