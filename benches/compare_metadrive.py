@@ -111,6 +111,8 @@ def parse_args() -> argparse.Namespace:
                         "interleaved with the others")
     p.add_argument("--json", dest="json_path", default=None)
     a = p.parse_args()
+    if a.also_planner is not None and not a.also_planner.strip():
+        p.error("--also-planner needs a planner name")
     if min(a.reps, a.vehicles, a.sweep_runs, a.threads, a.md_episodes, a.md_max_steps, a.md_procs) < 1:
         p.error("--reps, --vehicles, --sweep-runs, --threads, --md-episodes, --md-max-steps, --md-procs "
                 "must be >= 1")
@@ -345,6 +347,8 @@ class MergeSim:
         if kind == "run1" and note:
             self.label += note
         self.cmd += list(extra)
+        # The planner every vehicle runs when the command overrides the scenario's (--planner).
+        self.planner_override = extra[extra.index("--planner") + 1] if "--planner" in extra else None
         self.duration_s: float | None = None  # set from a `run` JSON (sweep JSON has no duration)
 
     def run(self) -> dict:
@@ -376,7 +380,7 @@ class MergeSim:
                 "wall_s": wall, "cpu_s": cpu, "inner_wall_s": float(d["wall_time_s"]),
                 "vehicle_s": vehicle_s, "sim_s": self.duration_s * len(done),
                 "vehicles": sorted(set(n_veh)), "runs": len(done), "plans": plans,
-                "collisions": d.get("collisions"),
+                "collisions": d.get("collisions"), "planner": self.planner_override,
             }
         n = len(d["vehicles"])
         return {
@@ -561,7 +565,9 @@ def main() -> int:
     out.append("¹ MetaDrive: wall time of the env.reset() + env.step() calls (imports and env construction excluded). "
                "² mergesim: wall time of the whole merge_sim process, measured around the subprocess (start-up "
                "included). ³ MetaDrive: env.step() calls only. ⁴ mergesim: the JSON's in-process `wall_time_s`. "
-               "Ratio = the row's median / MetaDrive's (driving vehicles) median, of the same column. "
+               "Ratio = the row's median / MetaDrive's (driving vehicles) median, of the same column: one "
+               "MetaDrive process, so the sweep rows (every core) are to be set beside MetaDrive's processes "
+               "at once, as in the sentences below the table. "
                "CPU / wall: 1.00 = one core busy; one MetaDrive process runs on one core.")
     if pool:
         both = summ["sweep"]["rate_median"] / summ["md_pool"]["rate_median"]

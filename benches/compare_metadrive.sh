@@ -71,7 +71,8 @@ Options:
                     also run the mergesim `run` on one core and the `sweep` with `--planner NAME`
                     (every vehicle) in place of PF-ISO, interleaved with the other variants:
                     e.g. idm-mobil (IDM + MOBIL, the kind of driver MetaDrive's IDMPolicy is), to
-                    separate the simulator's cost from the planner's. An unknown name: exit 2
+                    set the simulator's cost beside the planner's. A name merge_sim refuses
+                    (unknown, or one the platoon cannot run): exit 2
   --md-procs P      MetaDrive processes run at once for the all-cores row (default: every
                     core; 1 leaves the row out)
   --md-traffic-density D
