@@ -494,6 +494,44 @@ fn a_large_recording_is_announced_before_it_is_written() {
 }
 
 #[test]
+fn compare_refuses_a_planner_listed_twice_and_is_silent_with_quiet() {
+    let dir = scratch("compare_quiet");
+    let json = dir.join("cmp.json");
+    let out = merge_sim(&[
+        "compare",
+        "--planners",
+        "pf-cs,pf-cs",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--planners: pf-cs is listed twice"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!json.exists(), "nothing written before the refusal");
+
+    let out = merge_sim(&[
+        "compare",
+        "-q",
+        "--planners",
+        "pf-cs",
+        "--duration",
+        "1",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert!(json.exists(), "--quiet still writes the outputs asked for");
+}
+
+#[test]
 fn compare_outputs_name_the_scenario_parameter_set_and_commit() {
     let dir = scratch("compare_caption");
     let (json, markdown) = (dir.join("cmp.json"), dir.join("cmp.md"));

@@ -108,7 +108,11 @@ fn work_and_parallelism_are_bounded_up_front() {
         ),
         (
             vec!["scenario", "platoon", "--vehicles", "100000"],
-            "road.start_x_m",
+            "at most 200",
+        ),
+        (
+            vec!["scenario", "platoon", "--vehicles", "201"],
+            "a platoon needs at least one vehicle and at most 200",
         ),
     ] {
         let out = merge_sim(&args);

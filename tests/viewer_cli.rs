@@ -261,3 +261,40 @@ fn bad_follow_and_gif_options_are_refused_before_the_run() {
     let out = merge_sim(&["run", "--no-rrd", "--gif-fps", "5"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn view_without_the_rerun_viewer_on_path_is_refused_before_the_run() {
+    let dir = scratch("view_no_viewer");
+    let empty = dir.join("empty_path");
+    std::fs::create_dir_all(&empty).unwrap();
+    let rrd = dir.join("run.rrd");
+    let args = [
+        "run",
+        "--duration",
+        "1",
+        "--view",
+        "--rrd",
+        rrd.to_str().unwrap(),
+    ];
+    let out = common::merge_sim_env(&args, &[("PATH", empty.to_str().unwrap())]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--view: the Rerun viewer `rerun` is not on PATH"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!rrd.exists(), "refused before the run: no recording");
+
+    // A `rerun` on PATH (here a stand-in that exits at once) lets the run go ahead.
+    let bin = dir.join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    let viewer = bin.join("rerun");
+    std::fs::write(&viewer, "#!/bin/sh\nexit 0\n").unwrap();
+    {
+        use std::os::unix::fs::PermissionsExt as _;
+        std::fs::set_permissions(&viewer, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    let out = common::merge_sim_env(&args, &[("PATH", bin.to_str().unwrap())]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(rrd.exists());
+}

@@ -84,14 +84,16 @@ pub fn platoon_toml(vehicles: usize) -> String {
 
 /// The platoon with `vehicles` vehicles, loaded and checked like a scenario file.
 pub fn platoon(vehicles: usize) -> Result<Scenario, ScenarioError> {
-    if vehicles == 0 {
-        // The text of an empty platoon has no [[vehicles]] at all: say so, not "missing field".
+    if vehicles == 0 || vehicles > sim::config::MAX_VEHICLES {
+        // Refused before the text is written: an empty platoon has no [[vehicles]] at all
+        // ("missing field"), and a long one would be refused at a line of a text the user
+        // never sees (its road, or its vehicle count).
         return Err(ScenarioError::Invalid {
-            origin: "platoon --vehicles 0".into(),
+            origin: format!("platoon --vehicles {vehicles}"),
             line: Line(None),
             field: Some("vehicles".into()),
             message: format!(
-                "a platoon needs at least one vehicle (1 to {})",
+                "a platoon needs at least one vehicle and at most {}",
                 sim::config::MAX_VEHICLES
             ),
         });
@@ -115,6 +117,21 @@ mod tests {
             }
             other => panic!("{other:?}"),
         }
+        // One past the limit is refused by name too, with no line of the generated text.
+        match platoon(sim::config::MAX_VEHICLES + 1) {
+            Err(ScenarioError::Invalid {
+                field,
+                message,
+                line,
+                ..
+            }) => {
+                assert_eq!(field.as_deref(), Some("vehicles"));
+                assert_eq!(line.0, None);
+                assert!(message.contains("at most 200"), "{message}");
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(platoon(sim::config::MAX_VEHICLES).is_ok());
     }
 
     #[test]

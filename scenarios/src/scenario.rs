@@ -374,12 +374,20 @@ impl Scenario {
                 };
             }
             let nominal = sim_error_field(&e).and_then(|f| self.nominal_path(&f));
-            let field = sim_error_field(&e).map(|f| self.written_field(f));
+            let original = sim_error_field(&e);
+            let field = original.clone().map(|f| self.written_field(f));
+            let mut message = format!("{prefix}{e}");
+            if let (Some(original), Some(written)) = (&original, &field)
+                && original != written
+            {
+                // The message names the field as the file wrote it (`planners.TABLE.KEY`).
+                message = message.replacen(original.as_str(), written, 1);
+            }
             ScenarioError::Invalid {
                 origin: origin.to_string(),
                 line: at(entry.or(nominal)),
                 field,
-                message: format!("{prefix}{e}"),
+                message,
             }
         };
         self.sim.validate().map_err(|e| sim_error(e, "", None))?;

@@ -128,7 +128,8 @@ fn an_out_of_range_value_in_a_pf_table_is_refused_at_its_line() {
         e,
         line_of(&text, "risk_weight = -1.0"),
         "planners.pf-sp.risk_weight",
-        &["risk_weight"],
+        // The message names the table the file wrote, not the alias `planner.`.
+        &["planners.pf-sp.risk_weight = -1"],
     );
 }
 
@@ -333,5 +334,46 @@ fn params_for_a_planner_registered_without_a_type_are_refused_naming_it() {
         line_of(&text, "speed_mps = 3.0"),
         "planners.bare.speed_mps",
         &["planner bare takes no parameters"],
+    );
+}
+
+#[test]
+fn an_unknown_planner_in_a_vehicle_s_driver_is_refused_with_its_line() {
+    let text = text_with("", Some("driver = { planner = \"pf-isoo\" }"));
+    // The loader keeps names it does not know (a user's binary may register them) ...
+    let scenario = load(&text).unwrap();
+    // ... the run's registry refuses them, at the driver's line.
+    let e = scenario
+        .check_planners(&BehaviourRegistry::builtin())
+        .unwrap_err();
+    assert_refused(
+        e,
+        line_of(&text, "planner = \"pf-isoo\""),
+        "vehicles[ego].driver.planner",
+        &["unknown planner \"pf-isoo\"", "registered: ", "pf-iso"],
+    );
+    // A registry that holds the name accepts it.
+    let text = text_with("", Some("driver = { planner = \"cruise\" }"));
+    load(&text)
+        .unwrap()
+        .check_planners(&user_registry())
+        .unwrap();
+
+    // A prescribed driver's path planner.
+    let text = text_with(
+        "",
+        Some(
+            "driver = { prescribed = { path_planner = \"pf-css\", speed_profile = [[0.0, 15.0], [5.0, 12.0]] } }",
+        ),
+    );
+    let e = load(&text)
+        .unwrap()
+        .check_planners(&BehaviourRegistry::builtin())
+        .unwrap_err();
+    assert_refused(
+        e,
+        line_of(&text, "path_planner = \"pf-css\""),
+        "vehicles[ego].driver.prescribed.path_planner",
+        &["unknown planner \"pf-css\""],
     );
 }

@@ -238,7 +238,7 @@ impl From<GifViewArg> for crate::animation::GifView {
 pub(crate) struct CompareArgs {
     #[command(flatten)]
     pub(crate) source: ScenarioArgs,
-    /// Planners to compare, comma-separated.
+    /// Planners to compare, comma-separated, each once.
     #[arg(
         long,
         value_delimiter = ',',
@@ -257,14 +257,18 @@ pub(crate) struct CompareArgs {
     /// Write the table as Markdown here (its caption line first).
     #[arg(long, value_name = "PATH")]
     pub(crate) markdown: Option<PathBuf>,
-    /// Write figures into this existing folder: paths.png (both vehicles' paths per planner,
-    /// the paper's Fig. 3), states_<vehicle>.png (sideslip, yaw, yaw rate, speed over time per
-    /// planner; states_obstacle.png is the paper's Fig. 4) and time_series.csv (their data).
+    /// Write figures into this folder (created if missing; its parent must exist): paths.png
+    /// (both vehicles' paths per planner, the paper's Fig. 3), states_<vehicle>.png
+    /// (sideslip, yaw, yaw rate, speed over time per planner; states_obstacle.png is the
+    /// paper's Fig. 4) and time_series.csv (their data).
     #[arg(long, value_name = "DIR")]
     pub(crate) plots: Option<PathBuf>,
     /// Write each lane's id on the road of paths.png ("lane 1", at half the lane's length).
     #[arg(long, requires = "plots")]
     pub(crate) lane_ids: bool,
+    /// Print nothing but errors (no table, no progress, no "wrote" lines).
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
 }
 
 #[derive(Copy, Clone, Debug, ValueEnum)]
@@ -548,8 +552,9 @@ pub(crate) struct GridArgs {
     #[arg(long, default_value = "0", value_name = "K", value_parser = parse_seed)]
     pub(crate) seed: u64,
     /// Vehicle whose figures the table and the figure compare [default: the scenario's
-    /// vehicle named `obstacle` (the built-in merges' merging car), else its first vehicle not
-    /// named `ego`, else its first vehicle (the ego of a CommonRoad file)].
+    /// vehicle named `obstacle` (the built-in merges' car in the through lane, beside which
+    /// the ego merges), else its first vehicle not named `ego`, else its first vehicle (the
+    /// ego of a CommonRoad file)].
     #[arg(long, value_name = "NAME")]
     pub(crate) vehicle: Option<String>,
     /// Write every run (one line per run and vehicle) here.

@@ -58,6 +58,13 @@ pub(crate) fn progress_bar(quiet: bool, len: u64, message: String) -> indicatif:
 }
 
 pub(crate) fn cmd_compare(args: &CompareArgs, session: &Session) -> Result<(), Failure> {
+    for (i, name) in args.planners.iter().enumerate() {
+        if args.planners[..i].contains(name) {
+            return Err(input(anyhow!(
+                "--planners: {name} is listed twice (each planner runs once)"
+            )));
+        }
+    }
     let scenario = load_source(&args.source, &session.registry)?;
     check_outputs(
         &[
@@ -71,7 +78,7 @@ pub(crate) fn cmd_compare(args: &CompareArgs, session: &Session) -> Result<(), F
         let vehicles: Vec<&str> = scenario.vehicles.iter().map(|v| v.name.as_str()).collect();
         crate::plots::check_plot_dir(dir, &vehicles).map_err(|e| input(anyhow!(e)))?;
     }
-    let show_progress = std::io::stderr().is_terminal();
+    let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let mut summaries = Vec::new();
     let mut time_series = Vec::new();
     let mut collisions = Vec::new();
@@ -88,7 +95,9 @@ pub(crate) fn cmd_compare(args: &CompareArgs, session: &Session) -> Result<(), F
         time_series.push(finished.outcome.time_series);
         collisions.push(finished.outcome.safety.collisions);
     }
-    out!("{}", comparison_table(&caption, &summaries));
+    if !args.quiet {
+        out!("{}", comparison_table(&caption, &summaries));
+    }
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&comparison_json(&caption, &summaries))
             .map_err(run_failure)?;
@@ -119,8 +128,10 @@ pub(crate) fn cmd_compare(args: &CompareArgs, session: &Session) -> Result<(), F
             &caption,
         )
         .map_err(run_failure)?;
-        for path in written {
-            outln!("wrote {}", path.display());
+        if !args.quiet {
+            for path in written {
+                outln!("wrote {}", path.display());
+            }
         }
     }
     Ok(())

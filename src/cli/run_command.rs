@@ -60,6 +60,27 @@ struct RunJob<'a> {
     show_progress: bool,
 }
 
+/// The Rerun viewer's command (`--view`).
+const VIEWER: &str = "rerun";
+
+/// Whether an executable file `name` is in one of PATH's folders.
+fn on_path(name: &str) -> bool {
+    std::env::var_os("PATH").is_some_and(|paths| {
+        std::env::split_paths(&paths).any(|dir| is_executable(&dir.join(name)))
+    })
+}
+
+#[cfg(unix)]
+fn is_executable(path: &Path) -> bool {
+    use std::os::unix::fs::PermissionsExt as _;
+    std::fs::metadata(path).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+}
+
+#[cfg(not(unix))]
+fn is_executable(path: &Path) -> bool {
+    path.is_file() || path.with_extension("exe").is_file()
+}
+
 /// Step 1: loads the scenario and resolves every argument.
 fn load<'a>(
     args: &'a RunArgs,
@@ -127,6 +148,12 @@ impl RunJob<'_> {
             &self.inputs,
         )?;
         let follow = followed_vehicle(&self.scenario, self.follow)?;
+        if self.view && self.rrd.is_some() && !on_path(VIEWER) {
+            return Err(input(anyhow!(
+                "--view: the Rerun viewer `{VIEWER}` is not on PATH (install: pip install \
+                 rerun-sdk==0.36.3), or leave --view out and open the recording later"
+            )));
+        }
         if let Some((_, params)) = &self.gif {
             params.validate().map_err(input)?;
         }
@@ -211,7 +238,7 @@ impl RunJob<'_> {
         if self.view
             && let Some(path) = &self.rrd
         {
-            std::process::Command::new("rerun")
+            std::process::Command::new(VIEWER)
                 .arg(path)
                 .spawn()
                 .context(

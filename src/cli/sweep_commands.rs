@@ -198,7 +198,7 @@ pub(crate) fn cmd_sweep(args: &SweepArgs, session: &Session) -> Result<(), Failu
     let report = outcome.report();
     write_report(&report, args.json.as_deref(), args.parquet.as_deref())?;
     if !args.quiet {
-        out!("{}", report.table());
+        out!("{}", report.table_resumed(options.resume.len() as u64));
         let several = planner_count > 1;
         for row in report.rows().into_iter().filter(|r| r.error.is_some()) {
             outln!(

@@ -454,13 +454,19 @@ impl SweepReport {
 
     /// The terminal output: each planner's aggregate, then the paired differences.
     pub fn table(&self) -> String {
+        self.table_resumed(0)
+    }
+
+    /// [`table`](Self::table) of a sweep of which `resumed` runs were read back (`--resume`):
+    /// its rate counts only the runs of this attempt.
+    pub fn table_resumed(&self, resumed: u64) -> String {
         match self {
-            SweepReport::Single(s) => s.table(),
+            SweepReport::Single(s) => s.table_resumed(resumed),
             SweepReport::Paired(p) => {
                 let mut out = String::new();
                 let all_runs: u64 = p.per_planner.iter().map(|s| s.runs).sum();
                 for s in &p.per_planner {
-                    out.push_str(&s.table_in_paired_sweep(all_runs));
+                    out.push_str(&s.table_in_paired_sweep(all_runs, resumed));
                     out.push('\n');
                 }
                 out + &p.table()

@@ -279,29 +279,21 @@ impl SweepSummary {
 
     /// A few lines for the terminal.
     pub fn table(&self) -> String {
-        let per_s = if self.wall_time_s > 0.0 {
-            self.runs as f64 / self.wall_time_s
-        } else {
-            0.0
-        };
-        self.table_with_timing(&format!(
-            "{} runs in {:.1} s wall ({per_s:.2} runs/s)",
-            self.runs, self.wall_time_s
-        ))
+        self.table_resumed(0)
+    }
+
+    /// [`table`](Self::table) of a sweep of which `resumed` runs were read back (`--resume`)
+    /// rather than run: the rate is over the runs of this attempt's wall time only.
+    pub fn table_resumed(&self, resumed: u64) -> String {
+        self.table_with_timing(&timing_line(self.runs, resumed, self.wall_time_s))
     }
 
     /// [`table`](Self::table) of one planner of a paired sweep of `all_runs` runs, whose wall
-    /// time (in `wall_time_s`) is the whole paired sweep's.
-    pub(crate) fn table_in_paired_sweep(&self, all_runs: u64) -> String {
-        let per_s = if self.wall_time_s > 0.0 {
-            all_runs as f64 / self.wall_time_s
-        } else {
-            0.0
-        };
-        self.table_with_timing(&format!(
-            "{} runs (the paired sweep: {all_runs} runs in {:.1} s wall, {per_s:.2} runs/s)",
-            self.runs, self.wall_time_s
-        ))
+    /// time (in `wall_time_s`) is the whole paired sweep's; `resumed` of the `all_runs` were
+    /// read back (`--resume`).
+    pub(crate) fn table_in_paired_sweep(&self, all_runs: u64, resumed: u64) -> String {
+        let timing = timing_line(all_runs, resumed, self.wall_time_s);
+        self.table_with_timing(&format!("{} runs (the paired sweep: {timing})", self.runs))
     }
 
     fn table_with_timing(&self, timing: &str) -> String {
@@ -394,5 +386,43 @@ impl SweepSummary {
             text.push('\n');
         }
         Ok(text)
+    }
+}
+
+/// "N runs in T s wall (R runs/s)"; with `resumed` of the N read back (`--resume`), the rate
+/// is over the runs of this attempt only (a resumed sweep's wall time is this attempt's).
+fn timing_line(runs: u64, resumed: u64, wall_time_s: f64) -> String {
+    let ran = runs.saturating_sub(resumed);
+    let per_s = if wall_time_s > 0.0 {
+        ran as f64 / wall_time_s
+    } else {
+        0.0
+    };
+    if resumed == 0 {
+        format!("{runs} runs in {wall_time_s:.1} s wall ({per_s:.2} runs/s)")
+    } else {
+        format!(
+            "{runs} runs, {resumed} of them read back with --resume; {ran} run in this attempt, \
+             {wall_time_s:.1} s wall ({per_s:.2} runs/s)"
+        )
+    }
+}
+
+#[cfg(test)]
+mod timing_tests {
+    use super::timing_line;
+
+    #[test]
+    fn a_resumed_sweep_s_rate_counts_only_the_runs_of_this_attempt() {
+        assert_eq!(timing_line(8, 0, 2.0), "8 runs in 2.0 s wall (4.00 runs/s)");
+        assert_eq!(
+            timing_line(8, 6, 2.0),
+            "8 runs, 6 of them read back with --resume; 2 run in this attempt, 2.0 s wall \
+             (1.00 runs/s)"
+        );
+        // Nothing left to run: no rate made of the runs read back.
+        assert!(
+            timing_line(4, 4, 0.001).ends_with("0 run in this attempt, 0.0 s wall (0.00 runs/s)")
+        );
     }
 }

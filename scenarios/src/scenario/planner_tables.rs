@@ -248,6 +248,9 @@ impl Scenario {
                 invalid(&origin, text, &at, field, e.message)
             })?;
         }
+        if !skip_unknown {
+            self.check_driver_planner_names(registry, &origin, text)?;
+        }
         for (i, vehicle) in self.vehicles.iter().enumerate() {
             let Driver::Planner {
                 name,
@@ -302,6 +305,50 @@ impl Scenario {
             registry
                 .parse_params(name, &self.sim, Some(own))
                 .map_err(refused)?;
+        }
+        Ok(())
+    }
+
+    /// Every vehicle's planner name (`driver = { planner = "NAME" }`) and prescribed driver's
+    /// `path_planner` is in `registry`; an unknown name is refused with the file, line and
+    /// field, as an unknown `[sim.planners.NAME]` table is. (The run would refuse it too, but
+    /// without the line.)
+    fn check_driver_planner_names(
+        &self,
+        registry: &BehaviourRegistry,
+        origin: &str,
+        text: Option<&str>,
+    ) -> Result<(), ScenarioError> {
+        for (i, vehicle) in self.vehicles.iter().enumerate() {
+            let index = i.to_string();
+            let (name, key, field) = match &vehicle.driver {
+                Driver::Planner { name, .. } => (name, &["planner"][..], "driver.planner"),
+                Driver::Prescribed { path_planner, .. } => (
+                    path_planner,
+                    &["prescribed", "path_planner"][..],
+                    "driver.prescribed.path_planner",
+                ),
+                _ => continue,
+            };
+            if registry.contains(name) {
+                continue;
+            }
+            let mut exact = path(&["vehicles", &index, "driver"]);
+            exact.extend(key.iter().map(|k| k.to_string()));
+            return Err(invalid(
+                origin,
+                text,
+                &[
+                    exact,
+                    path(&["vehicles", &index, "driver"]),
+                    path(&["vehicles", &index]),
+                ],
+                format!("vehicles[{}].{field}", vehicle.name),
+                format!(
+                    "unknown planner {name:?} (registered: {})",
+                    registry.names().join(", ")
+                ),
+            ));
         }
         Ok(())
     }
