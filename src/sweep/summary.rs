@@ -292,7 +292,19 @@ impl SweepSummary {
     /// time (in `wall_time_s`) is the whole paired sweep's; `resumed` of the `all_runs` were
     /// read back (`--resume`).
     pub(crate) fn table_in_paired_sweep(&self, all_runs: u64, resumed: u64) -> String {
-        let timing = timing_line(all_runs, resumed, self.wall_time_s);
+        let timing = if resumed == 0 {
+            let per_s = if self.wall_time_s > 0.0 {
+                all_runs as f64 / self.wall_time_s
+            } else {
+                0.0
+            };
+            format!(
+                "{all_runs} runs in {:.1} s wall, {per_s:.2} runs/s",
+                self.wall_time_s
+            )
+        } else {
+            timing_line(all_runs, resumed, self.wall_time_s)
+        };
         self.table_with_timing(&format!("{} runs (the paired sweep: {timing})", self.runs))
     }
 
