@@ -24,6 +24,7 @@
 pub mod animation;
 pub mod build_info;
 pub mod cli;
+pub mod error_text;
 pub mod exact_seed;
 pub mod experiment;
 pub(crate) mod grid;

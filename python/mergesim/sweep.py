@@ -22,6 +22,11 @@ from ._common import (
 #: every reader, pandas included); decimal strings of older files are read too.
 _SEED_FIELDS = ("seed", "sweep_seed")
 
+#: Row fields that hold text (null where absent, e.g. ``error`` of a completed run): never cast
+#: to float, however many of them are null.
+_TEXT_FIELDS = frozenset({"scenario", "scenario_fingerprint", "params", "planners", "planner",
+                          "status", "error"})
+
 #: Run-level figures whose ``null`` means "never" (+∞: no pair ever came within range / was ever
 #: closing), each with the boolean column that says so.
 NEVER_FLAGS = {"min_gap_m": "min_gap_never", "min_ttc_s": "min_ttc_never"}
@@ -114,6 +119,14 @@ def rows_frame(lines: Iterable[str]) -> pd.DataFrame:
     for field in _SEED_FIELDS:
         if field in frame.columns:
             frame[field] = frame[field].map(_seed_value).astype("uint64")
+    # A figure that is null in every row (e.g. min_ttc_s when no pair ever closed) would be an
+    # object column of None; it is a float column of NaN, as read_json and read_parquet give.
+    for column in frame.columns:
+        if column in _TEXT_FIELDS or frame[column].dtype != object:
+            continue
+        present = frame[column].dropna()
+        if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in present):
+            frame[column] = frame[column].astype("float64")
     return frame
 
 

@@ -204,10 +204,11 @@ impl EnvCore {
             ))
             .into());
         }
-        // Its vehicle models (`params={"sim": {"vehicle_model": "ks"}}`), refused here rather
-        // than at the first reset.
+        // Its vehicle models (`params={"sim": {"vehicle_model": "ks"}}`), its drivers'
+        // planners and their tables, refused here (with the file's line) rather than at the
+        // first reset, as `merge_sim run` refuses them.
         scenario
-            .check_vehicle_models(&registry)
+            .check_planners(&registry)
             .map_err(|e| BindingError::input(&e))?;
         let commands: Vec<SharedCommand> = agents
             .iter()

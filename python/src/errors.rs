@@ -1,7 +1,7 @@
 //! Errors of the bindings and how they reach Python: bad input (what `merge_sim` rejects with
 //! exit code 2) raises `mergesim.ScenarioError` (a `ValueError`), a failure while simulating
 //! (exit code 1) `mergesim.SimulationError` (a `RuntimeError`). The message is the CLI's, without
-//! its `error: ` prefix: the error and its causes joined by `: ` (anyhow's `{:#}`).
+//! its `error: ` prefix: the error and its causes joined by `: `, none repeated (`chain`).
 
 use pyo3::PyErr;
 use pyo3::create_exception;
@@ -54,15 +54,8 @@ impl From<BindingError> for PyErr {
     }
 }
 
-/// `error` and its sources joined by `: ` (what `eprintln!("error: {e:#}")` prints of an
-/// `anyhow::Error` after `error: `).
+/// `error` and its sources joined by `: `, a source its message already ends with left out:
+/// what `merge_sim` prints after `error: ` (`mergesim::error_text`).
 pub(crate) fn chain(error: &(dyn std::error::Error + 'static)) -> String {
-    let mut text = error.to_string();
-    let mut source = error.source();
-    while let Some(cause) = source {
-        text.push_str(": ");
-        text.push_str(&cause.to_string());
-        source = cause.source();
-    }
-    text
+    mergesim::error_text::error_chain(error)
 }

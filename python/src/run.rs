@@ -31,6 +31,11 @@ pub(crate) fn run(
             BindingError::Input(mergesim::experiment::unknown_planner(&registry, name)).into(),
         );
     }
+    // The scenario's planners, their tables and vehicle models, with the file's line, as
+    // `merge_sim run` checks them.
+    scenario
+        .check_planners(&registry)
+        .map_err(|e| BindingError::input(&e))?;
     let planner = planner.map(str::to_string);
     let finished = run_interruptible(py, None, |interrupt| {
         let options = InstanceOptions {

@@ -28,6 +28,13 @@ pub(crate) fn sweep(
     threads: Option<usize>,
 ) -> PyResult<Vec<String>> {
     let scenario = source::load(scenario, params_json)?;
+    // The built-in planners and the Python ones registered now.
+    let registry = std::sync::Arc::new(crate::py_planner::registry()?);
+    // The scenario's planners, their tables and vehicle models, with the file's line, as
+    // `merge_sim sweep` checks them.
+    scenario
+        .check_planners(&registry)
+        .map_err(|e| BindingError::input(&e))?;
     let plan = PairedSweepPlan {
         scenario,
         planners,
@@ -35,8 +42,6 @@ pub(crate) fn sweep(
         seed,
         shard: Shard::WHOLE,
     };
-    // The built-in planners and the Python ones registered now.
-    let registry = std::sync::Arc::new(crate::py_planner::registry()?);
     let outcome = run_interruptible(py, Some(1), |interrupt| {
         // The sweep builds its own pool of `threads` workers (one per core by default).
         let options = SweepOptions {

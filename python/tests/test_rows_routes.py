@@ -152,3 +152,17 @@ def test_never_reads_the_same_by_every_route(cli_sweep, closing: pathlib.Path) -
         inf = mergesim.never_as_infinity(frame, "min_ttc_s")
         assert list(np.isinf(inf)) == list(reference["min_ttc_never"]), name
         assert inf.median() == mergesim.never_as_infinity(reference, "min_ttc_s").median()
+
+
+def test_a_figure_that_is_never_in_every_row_is_a_float_column(short_urgent_merge: pathlib.Path) -> None:
+    """In the unchanged urgent merge no pair ever closes: min_ttc_s is "never" in every row, a
+    column of NaN (float64, as read_json and read_parquet read it), not an object column of
+    None; text columns stay text."""
+    frame = mergesim.sweep(short_urgent_merge, planners=PLANNERS, runs=2, seed=SEED)
+    assert frame["min_ttc_never"].all(), "expected no closing pair in any run"
+    for column in ["min_ttc_s", "ego.slowing_onset_s", "obstacle.slowing_onset_s"]:
+        if frame[column].isna().all():
+            assert frame[column].dtype == np.float64, (column, frame[column].dtype)
+    assert frame["min_ttc_s"].dtype == np.float64
+    assert frame["min_ttc_s"].mean() != frame["min_ttc_s"].mean()  # NaN: skipped by mean()
+    assert frame["planner"].dtype != np.float64 and set(frame["planner"]) == set(PLANNERS)

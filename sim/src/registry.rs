@@ -322,14 +322,18 @@ impl BehaviourRegistry {
         schema: Schema,
     ) -> Result<(), SimError> {
         if name.is_empty() || name.contains(|c: char| c.is_whitespace() || c == ',' || c == '"') {
-            return Err(SimError::InvalidScenario(format!(
-                "planner name {name:?} must be non-empty, without spaces, commas or quotes"
-            )));
+            return Err(SimError::InvalidField {
+                field: "name".into(),
+                message: format!(
+                    "planner name {name:?} must be non-empty, without spaces, commas or quotes"
+                ),
+            });
         }
         if self.factories.contains_key(name) {
-            return Err(SimError::InvalidScenario(format!(
-                "planner name {name:?} is already registered"
-            )));
+            return Err(SimError::InvalidField {
+                field: "name".into(),
+                message: format!("planner name {name:?} is already registered"),
+            });
         }
         self.factories.insert(name.to_string(), factory);
         self.schemas.insert(name.to_string(), schema);

@@ -164,14 +164,18 @@ impl VehicleModelRegistry {
         factory: VehicleModelFactory,
     ) -> Result<(), SimError> {
         if name.is_empty() || name.contains(|c: char| c.is_whitespace() || c == ',' || c == '"') {
-            return Err(SimError::InvalidScenario(format!(
-                "vehicle model name {name:?} must be non-empty, without spaces, commas or quotes"
-            )));
+            return Err(SimError::InvalidField {
+                field: "name".into(),
+                message: format!(
+                    "vehicle model name {name:?} must be non-empty, without spaces, commas or quotes"
+                ),
+            });
         }
         if self.contains(name) {
-            return Err(SimError::InvalidScenario(format!(
-                "vehicle model name {name:?} is already registered"
-            )));
+            return Err(SimError::InvalidField {
+                field: "name".into(),
+                message: format!("vehicle model name {name:?} is already registered"),
+            });
         }
         self.entries
             .push((name.to_string(), description.to_string(), factory));

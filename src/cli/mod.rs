@@ -98,11 +98,11 @@ pub fn main_with(registry: BehaviourRegistry) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(e)) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", crate::error_text::error_chain(e.as_ref()));
             ExitCode::from(2)
         }
         Err(Failure::Run(e)) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", crate::error_text::error_chain(e.as_ref()));
             ExitCode::from(1)
         }
         Err(Failure::Interrupted { code, message }) => {

@@ -440,7 +440,9 @@ pub fn markdown(report: &StudyReport) -> String {
          signed-rank p-values; median and p90 of d by nearest rank.\n\
          - Verdict against the threshold δ: **negligible** when the CI lies entirely inside \
          (−δ, δ); **relevant** when it lies entirely beyond δ or below −δ; else \
-         **inconclusive**.\n\
+         **inconclusive**; **not estimable** (`not-estimable` in the JSON) when fewer than two \
+         differences remain or all are equal — e.g. a figure that is \"never\" (+∞: min TTC, \
+         min gap, slowing onset, divider crossing) in every run, since such runs are left out.\n\
          - The primary endpoint stands alone (no correction). Holm's correction runs over the \
          secondary endpoints of one planner pair in one cell: that is the family.\n\
          - Collisions: motion-state endpoints (per-vehicle figures) are tested over the **{}** \
