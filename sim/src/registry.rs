@@ -139,7 +139,9 @@ enum Schema {
 /// It also carries the vehicle models the cars are spawned with
 /// ([`crate::vehicle_models::VehicleModelRegistry`], the built-in ones unless
 /// [`BehaviourRegistry::with_vehicle_models`] gives others), so that everything that takes a
-/// registry (the CLI, sweeps, grids, studies, Python) knows a user's models too.
+/// registry (the CLI of `mergesim::cli::main_with`, sweeps, grids, studies) knows a user's
+/// models too. Python's API builds its own registry (the built-ins and the planners registered
+/// in Python), so it does not see a user's Rust registry.
 #[derive(Clone)]
 pub struct BehaviourRegistry {
     factories: BTreeMap<String, BehaviourFactory>,
