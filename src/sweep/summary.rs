@@ -293,11 +293,7 @@ impl SweepSummary {
     /// read back (`--resume`).
     pub(crate) fn table_in_paired_sweep(&self, all_runs: u64, resumed: u64) -> String {
         let timing = if resumed == 0 {
-            let per_s = if self.wall_time_s > 0.0 {
-                all_runs as f64 / self.wall_time_s
-            } else {
-                0.0
-            };
+            let per_s = runs_per_s(all_runs, self.wall_time_s);
             format!(
                 "{all_runs} runs in {:.1} s wall, {per_s:.2} runs/s",
                 self.wall_time_s
@@ -401,15 +397,20 @@ impl SweepSummary {
     }
 }
 
+/// `runs` over `wall_time_s` (0 for no time at all).
+fn runs_per_s(runs: u64, wall_time_s: f64) -> f64 {
+    if wall_time_s > 0.0 {
+        runs as f64 / wall_time_s
+    } else {
+        0.0
+    }
+}
+
 /// "N runs in T s wall (R runs/s)"; with `resumed` of the N read back (`--resume`), the rate
 /// is over the runs of this attempt only (a resumed sweep's wall time is this attempt's).
 fn timing_line(runs: u64, resumed: u64, wall_time_s: f64) -> String {
     let ran = runs.saturating_sub(resumed);
-    let per_s = if wall_time_s > 0.0 {
-        ran as f64 / wall_time_s
-    } else {
-        0.0
-    };
+    let per_s = runs_per_s(ran, wall_time_s);
     if resumed == 0 {
         format!("{runs} runs in {wall_time_s:.1} s wall ({per_s:.2} runs/s)")
     } else {
